@@ -1,0 +1,44 @@
+// SPDX-License-Identifier: MIT
+// The one place that maps an algorithm name to its builder. The CLI, the benchmarks and the tests all
+// go through build(), so a new algorithm reaches all three after one edit here (STYLE.md §3).
+#pragma once
+
+#include <optional>
+#include <span>
+#include <string_view>
+
+#include "hbvh/build/report.hpp"
+#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+enum class Algorithm {
+    two_level,
+};
+
+/// One row of the registry: CLI name and a one-line summary.
+struct AlgorithmInfo {
+    Algorithm algorithm;
+    std::string_view name;
+    std::string_view summary;
+};
+
+/// Every registered builder, in the order `hbvh algorithms` lists them.
+[[nodiscard]] std::span<const AlgorithmInfo> algorithms();
+[[nodiscard]] std::optional<Algorithm> parse_algorithm(std::string_view name);
+[[nodiscard]] std::string_view to_string(Algorithm algorithm);
+
+/// Options common to all builders. Algorithm-specific knobs live in each builder's own options struct.
+struct BuildOptions {
+    VolumePolicy policy;
+    BuildReport* report = nullptr;  ///< Filled when non-null.
+};
+
+/// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
+/// Returns an Error for an empty input.
+[[nodiscard]] Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm,
+                                const BuildOptions& options = {});
+
+}  // namespace hbvh

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: MIT
+// The set-partition problem of the survey's §3 (Eqs. 4-6): choose merging candidates that cover every
+// node of a level exactly once at minimum total cost.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <vector>
+
+namespace hbvh {
+
+/// One merging candidate: the level's node indices it merges (ascending, distinct) and its cost.
+struct Candidate {
+    std::vector<std::uint32_t> members;
+    double cost = 0.0;
+};
+
+/// Limits for a solver; 0 means unlimited.
+struct SolverBudget {
+    std::uint64_t max_nodes = 0;   ///< Search-tree nodes.
+    double max_seconds = 0.0;
+};
+
+/// A solver's answer: indices into the candidate list, ascending.
+struct Partition {
+    std::vector<std::uint32_t> chosen;
+    double cost = 0.0;
+    std::uint64_t nodes_explored = 0;
+    bool budget_hit = false;  ///< Stopped early; `chosen` is the best found, optimality not proven.
+    double lower_bound = 0.0; ///< Proven lower bound on the optimum (== cost when proven optimal).
+};
+
+}  // namespace hbvh

@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+// VolumePolicy: which BV kinds a builder may use and how much each one's volume counts.
+#pragma once
+
+#include <array>
+#include <string_view>
+
+#include "hbvh/geometry/bounding_volume.hpp"
+#include "hbvh/result.hpp"
+
+namespace hbvh {
+
+/// The BV kinds a hierarchy may use for inner nodes, with a weight per kind.
+/// A weighted volume (weight x volume) is what fit_best minimises and what the cost sums: the survey's
+/// §6.1 idea of charging complex BVs for their slower overlap tests. All weights default to 1.
+struct VolumePolicy {
+    std::array<bool, bv_type_count> allowed{true, true, true, true};
+    std::array<double, bv_type_count> weight{1.0, 1.0, 1.0, 1.0};
+
+    [[nodiscard]] bool is_allowed(BvType type) const { return allowed[static_cast<std::size_t>(type)]; }
+    [[nodiscard]] double weight_of(BvType type) const { return weight[static_cast<std::size_t>(type)]; }
+    /// weight(type of bv) x volume(bv).
+    [[nodiscard]] double weighted_volume(const BoundingVolume& bv) const { return weight_of(type_of(bv)) * volume(bv); }
+
+    /// Every kind allowed, weight 1.
+    [[nodiscard]] static VolumePolicy all() { return {}; }
+    /// Only `type` allowed.
+    [[nodiscard]] static VolumePolicy only(BvType type);
+};
+
+/// Parses "aabb,obb,sphere,capsule" (any non-empty subset, any order). Error names the bad word.
+[[nodiscard]] Result<VolumePolicy> parse_allowed_types(std::string_view list, VolumePolicy base = {});
+/// Parses "obb=1.5,capsule=1.2" into weights (positive, finite). Error names the bad entry.
+[[nodiscard]] Result<VolumePolicy> parse_type_weights(std::string_view list, VolumePolicy base = {});
+
+}  // namespace hbvh

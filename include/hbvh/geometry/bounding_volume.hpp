@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// BoundingVolume: the closed set of BV kinds, and the operations every kind supports.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <string_view>
+#include <variant>
+#include <vector>
+
+#include "hbvh/geometry/aabb.hpp"
+#include "hbvh/geometry/capsule.hpp"
+#include "hbvh/geometry/obb.hpp"
+#include "hbvh/geometry/sphere.hpp"
+
+namespace hbvh {
+
+/// Bounding volume of one node. The set of kinds is closed, so a variant fits better than a hierarchy.
+/// The index order matches BvType.
+using BoundingVolume = std::variant<Aabb, Obb, Sphere, Capsule>;
+
+/// The kind of a BoundingVolume, in variant order.
+enum class BvType : std::uint8_t { aabb = 0, obb = 1, sphere = 2, capsule = 3 };
+inline constexpr std::size_t bv_type_count = 4;
+inline constexpr std::array<BvType, bv_type_count> all_bv_types{BvType::aabb, BvType::obb, BvType::sphere,
+                                                                  BvType::capsule};
+
+[[nodiscard]] inline BvType type_of(const BoundingVolume& bv) { return static_cast<BvType>(bv.index()); }
+/// "aabb", "obb", "sphere" or "capsule".
+[[nodiscard]] std::string_view to_string(BvType type);
+/// Inverse of to_string; nullopt for an unknown name.
+[[nodiscard]] std::optional<BvType> parse_bv_type(std::string_view name);
+
+/// Volume of the solid (cubic units).
+[[nodiscard]] double volume(const BoundingVolume& bv);
+/// The BV moved rigidly. An Aabb under a rotation becomes an Obb, so the result is exact.
+[[nodiscard]] BoundingVolume transformed(const BoundingVolume& bv, const RigidTransform& t);
+/// True when every point of `s` lies in `bv`, allowing `tolerance` (absolute length).
+[[nodiscard]] bool contains(const BoundingVolume& bv, const Sphere& s, double tolerance = 0.0);
+/// Smallest world axis-aligned box around the BV (exact for every kind).
+[[nodiscard]] Aabb world_aabb(const BoundingVolume& bv);
+/// A length scale of the BV (half the diagonal of its world AABB), used to make tolerances relative.
+[[nodiscard]] double size_scale(const BoundingVolume& bv);
+
+/// The generating spheres of a BV: a finite set of spheres whose convex hull is the BV.
+/// Box -> its 8 corners as radius-0 spheres; sphere -> itself; capsule -> its two end spheres.
+/// Because every BV kind is convex, a convex BV contains the BV iff it contains these spheres.
+void append_generating_spheres(const BoundingVolume& bv, std::vector<Sphere>& out);
+[[nodiscard]] std::vector<Sphere> generating_spheres(const BoundingVolume& bv);
+
+}  // namespace hbvh

@@ -1,0 +1,89 @@
+// SPDX-License-Identifier: MIT
+#include "hbvh/tree/bvh.hpp"
+
+#include <algorithm>
+#include <deque>
+
+#include "hbvh/assert.hpp"
+
+namespace hbvh {
+
+std::vector<std::vector<std::uint32_t>> levels(const Bvh& bvh) {
+    std::vector<std::vector<std::uint32_t>> result;
+    if (bvh.empty()) return result;
+    std::vector<std::uint32_t> current{0};
+    while (!current.empty()) {
+        std::vector<std::uint32_t> next;
+        for (std::uint32_t index : current) {
+            const Node& node = bvh.nodes[index];
+            for (std::uint32_t c = 0; c < node.child_count; ++c) next.push_back(node.first_child + c);
+        }
+        result.push_back(std::move(current));
+        current = std::move(next);
+    }
+    return result;
+}
+
+std::vector<std::uint32_t> covered_primitives(const Bvh& bvh, std::uint32_t index) {
+    std::vector<std::uint32_t> out;
+    std::vector<std::uint32_t> stack{index};
+    while (!stack.empty()) {
+        const Node& node = bvh.nodes[stack.back()];
+        stack.pop_back();
+        if (node.is_leaf()) out.push_back(node.primitive);
+        for (std::uint32_t c = 0; c < node.child_count; ++c) stack.push_back(node.first_child + c);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+TreeAssembler::TreeAssembler(std::span<const Primitive> primitives)
+    : primitives_(primitives.begin(), primitives.end()) {}
+
+std::uint32_t TreeAssembler::add_leaf(std::uint32_t primitive) {
+    HBVH_ASSERT(primitive < primitives_.size());
+    items_.push_back({primitives_[primitive].volume, {}, primitive});
+    return static_cast<std::uint32_t>(items_.size() - 1);
+}
+
+std::uint32_t TreeAssembler::add_group(std::span<const std::uint32_t> children, BoundingVolume volume) {
+    HBVH_ASSERT(!children.empty());
+    for (std::uint32_t child : children) HBVH_ASSERT(child < items_.size());
+    items_.push_back({std::move(volume), {children.begin(), children.end()}, 0});
+    return static_cast<std::uint32_t>(items_.size() - 1);
+}
+
+void TreeAssembler::set_volume(std::uint32_t id, BoundingVolume volume) { items_.at(id).volume = std::move(volume); }
+
+Bvh TreeAssembler::finish(std::uint32_t root) && {
+    // A group with one child adds a level without adding a choice: replace it by its child.
+    auto skip_single = [&](std::uint32_t id) {
+        while (items_[id].children.size() == 1) id = items_[id].children.front();
+        return id;
+    };
+    Bvh bvh;
+    bvh.primitives = std::move(primitives_);
+    if (items_.empty()) return bvh;
+
+    // Breadth-first layout: a node's children are appended together, so they are contiguous.
+    std::deque<std::pair<std::uint32_t, std::uint32_t>> queue;  // (item id, node index)
+    root = skip_single(root);
+    bvh.nodes.push_back({items_[root].volume, 0, 0, items_[root].primitive});
+    queue.emplace_back(root, 0);
+    while (!queue.empty()) {
+        const auto [id, index] = queue.front();
+        queue.pop_front();
+        const Item& item = items_[id];
+        if (item.children.empty()) continue;
+        bvh.nodes[index].first_child = static_cast<std::uint32_t>(bvh.nodes.size());
+        bvh.nodes[index].child_count = static_cast<std::uint32_t>(item.children.size());
+        for (std::uint32_t child : item.children) {
+            const std::uint32_t real = skip_single(child);
+            bvh.nodes.push_back({items_[real].volume, 0, 0, items_[real].primitive});
+            queue.emplace_back(real, static_cast<std::uint32_t>(bvh.nodes.size() - 1));
+        }
+    }
+    return bvh;
+}
+
+}  // namespace hbvh
