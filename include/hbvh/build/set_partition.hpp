@@ -31,3 +31,24 @@ struct Partition {
 };
 
 }  // namespace hbvh
+
+#include <span>
+
+namespace hbvh {
+
+/// The survey's branch and bound (§3, Appendix A, Algorithms 2-3): a binary selector over candidates in
+/// list order, a stack of chosen candidates, bound = cost so far + 2 x sum of volumes of uncovered nodes
+/// (Eq. 7), with a growable bitset instead of the survey's 32-bit word. `node_volumes[j]` is the volume of
+/// node j's BV. Kept as the reference solver. nullopt when no exact cover exists.
+[[nodiscard]] std::optional<Partition> solve_reference_branch_and_bound(std::uint32_t node_count,
+                                                                        std::span<const Candidate> candidates,
+                                                                        std::span<const double> node_volumes,
+                                                                        const SolverBudget& budget = {});
+
+/// hbvh's exact solver: branch on the uncovered node with the fewest candidates, admissible per-node
+/// lower bound, greedy + local-search initial solution. Same optimum as exhaustive search.
+/// nullopt when no exact cover exists.
+[[nodiscard]] std::optional<Partition> solve_exact(std::uint32_t node_count, std::span<const Candidate> candidates,
+                                                   const SolverBudget& budget = {});
+
+}  // namespace hbvh
