@@ -93,7 +93,7 @@ Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool e
         // A fatter capsule can be shorter: the end caps then swallow spheres near the ends. Sample radii
         // geometrically up to one length more, then golden-section search around the best sample.
         std::vector<double> radii{min_radius};
-        for (double g = 1.0 / 256.0; g <= 1.0; g *= 2.0) radii.push_back(min_radius + g * first_length);
+        for (double g = 1.0 / 64.0; g <= 1.0; g *= 2.0) radii.push_back(min_radius + g * first_length);
         std::size_t best = 0;
         double best_volume = volume_at(radii[0]);
         for (std::size_t i = 1; i < radii.size(); ++i) {
@@ -108,7 +108,9 @@ Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool e
         double x2 = a + ratio * (b - a);
         double f1 = volume_at(x1);
         double f2 = volume_at(x2);
-        for (int iteration = 0; iteration < 30; ++iteration) {
+        // 16 steps shrink the bracket to 5e-4 of its width; near the optimum the volume is flat (quadratic),
+        // so the remaining error is far below anything a builder could notice.
+        for (int iteration = 0; iteration < 16; ++iteration) {
             if (f1 < f2) {
                 b = x2, x2 = x1, f2 = f1;
                 x1 = b - ratio * (b - a), f1 = volume_at(x1);
