@@ -150,10 +150,11 @@ Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_
 
     // Stage 1: candidate directions. The principal axes of the centres and of the hull, every axis of the
     // OBB candidate frames (world, DiTO, hints): a capsule's axis usually follows the longest box side.
+    const detail::SphereProxy proxy = detail::make_proxy(spheres, hull);
     const Mat3 point_frame = detail::principal_frame(detail::point_covariance(spheres));
     std::vector<Mat3> frames{point_frame, detail::principal_frame(hull.covariance), Mat3::Identity()};
     for (const Mat3& axes : detail::dito_frames(spheres)) frames.push_back(axes);
-    for (const Mat3& axes : hint_axes) frames.push_back(detail::proper_frame(axes));
+    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) frames.push_back(axes);
     std::vector<Vec3> directions;
     directions.reserve(3 * frames.size());
     for (const Mat3& frame : frames)
@@ -161,7 +162,6 @@ Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_
 
     // Stage 2: rank directions by a cheap capsule (axis through the centre of the cross-sections' bounding
     // rectangle) around the proxy: hull vertices and spheres of positive radius.
-    const detail::SphereProxy proxy = detail::make_proxy(spheres, hull);
     std::vector<std::pair<double, std::size_t>> ranked;
     ranked.reserve(directions.size());
     for (std::size_t i = 0; i < directions.size(); ++i)

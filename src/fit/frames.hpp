@@ -16,11 +16,21 @@ namespace hbvh::detail {
 /// extent. Ranking orientations on this subset is therefore exact, yet costs O(hull size) for boxes.
 struct SphereProxy {
     std::vector<Sphere> spheres;
+    std::vector<Vec3> hull_points;  ///< Centres of the hull vertices only: a cheaper, coarser stand-in.
     double max_radius = 0.0;
 };
 
 /// The proxy of `spheres`, whose centres' hull is `hull`.
 [[nodiscard]] SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull);
+
+/// How many hint frames reach the exact ranking; the rest are dropped by a coarse pre-ranking, so that a
+/// node over thousands of differently oriented boxes does not cost (boxes x spheres).
+inline constexpr std::size_t max_ranked_hints = 8;
+
+/// The (at most) `limit` hints, made proper, whose boxes around the hull points padded by the largest
+/// radius (an upper bound, O(hull size) each) are smallest. All of them, in order, when there are few.
+[[nodiscard]] std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> hints,
+                                             std::size_t limit = max_ranked_hints);
 
 /// `axes` made a proper rotation: columns orthonormalised in order (Gram-Schmidt), the last one
 /// completed by a cross product so that det = +1. A column of zero length is replaced by any perpendicular.

@@ -27,7 +27,7 @@ Obb fit_obb(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes) {
     // O(proxy size) each, so that many hints stay cheap.
     std::vector<Mat3> candidates;
     candidates.reserve(hint_axes.size() + 24);
-    for (const Mat3& axes : hint_axes) candidates.push_back(detail::proper_frame(axes));
+    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) candidates.push_back(axes);
     for (const Mat3& axes : detail::dito_frames(spheres)) candidates.push_back(axes);
     // Face-flush frames: along each large hull face normal and each covariance axis (for a flat set the
     // smallest axis is the plane's normal, and the 2-D rectangle step then finds the best in-plane box).
