@@ -176,6 +176,18 @@ TEST(Fit, ObbIsNoLargerThanAabbOrCovarianceBoxAndProper) {
     }
 }
 
+TEST(Fit, CapsuleIsNoLargerThanSphere) {
+    // The minimum sphere is a zero-length capsule and one of fit_capsule's candidates. Allow for the
+    // capsule's rounding pad, a few ulps of the coordinates' magnitude.
+    for (const SphereSet& set : all_sets()) {
+        const Sphere sphere = fit_sphere(set.spheres);
+        const Aabb aabb = fit_aabb(set.spheres);
+        const double magnitude = std::max(aabb.min.cwiseAbs().maxCoeff(), aabb.max.cwiseAbs().maxCoeff());
+        const Sphere allowance{sphere.center, sphere.radius + 8.0 * 0x1.0p-52 * magnitude};
+        EXPECT_LE(fit_capsule(set.spheres, set.hints).volume(), allowance.volume() * (1.0 + 1e-12)) << set.name;
+    }
+}
+
 TEST(Fit, FitDispatchMatchesKindFitters) {
     const SphereSet set = random_sets()[7];
     EXPECT_EQ(volume(fit(BvType::sphere, set.spheres)), fit_sphere(set.spheres).volume());
