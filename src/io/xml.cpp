@@ -322,8 +322,11 @@ Result<BoundingVolume> Reader::read_volume(const pugi::xml_node& element, std::s
         // Length 0 is a sphere written as a capsule; that is still a valid capsule.
         const Result<double> length = read_size(element, *length_attribute, true);
         if (!length) return length.error();
-        const Vec3 half_axis = (0.5 * *length / norm) * direction;
-        return BoundingVolume(Capsule{centre - half_axis, centre + half_axis, *radius});
+        const Vec3 half_axis = (0.5 * *length) * Vec3(direction / norm);
+        const Capsule capsule{centre - half_axis, centre + half_axis, *radius};
+        if (!capsule.p0.allFinite() || !capsule.p1.allFinite())
+            return error(element_line(), "capsule ends overflow the range of double");
+        return BoundingVolume(capsule);
     }
 
     // Boxes: full extents along the local x, y, z axes.
@@ -338,7 +341,16 @@ Result<BoundingVolume> Reader::read_volume(const pugi::xml_node& element, std::s
     const Vec3 half = 0.5 * extents;
     // The survey's footnote 4: "AABBs are OBBs with no orientation".
     const pugi::xml_attribute orientation_attribute = element.attribute("orientation");
-    if (!orientation_attribute) return BoundingVolume(Aabb{centre - half, centre + half});
+    if (!orientation_attribute) {
+        // Stored as corners, an AABB can lose what the file says: far from the origin a small extent
+        // rounds away, and a huge one overflows. Refuse instead of returning a flat or infinite box.
+        const Aabb box{centre - half, centre + half};
+        if (!box.min.allFinite() || !box.max.allFinite())
+            return error(element_line(), "box corners overflow the range of double");
+        if (((box.max - box.min).array() <= 0.0).any())
+            return error(element_line(), "box extents vanish in rounding: they are too small for its position");
+        return BoundingVolume(box);
+    }
     const Result<Mat3> rotation = read_orientation(element, orientation_attribute);
     if (!rotation) return rotation.error();
     return BoundingVolume(Obb{centre, *rotation, half});

@@ -337,6 +337,13 @@ const BadInput bad_inputs[] = {
     {"nan", H "  <volume type=\"sphere\" pos=\"0 NaN 0\" radius=\"1\"/>\n</hierarchy>", 2, "not a finite number"},
     {"inf", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"inf\"/>\n</hierarchy>", 2, "not a finite number"},
     {"overflow", H "  <volume type=\"sphere\" pos=\"0 0 1e999\" radius=\"1\"/>\n</hierarchy>", 2, "out of the range"},
+    {"underflow", H "  <volume type=\"sphere\" pos=\"0 0 1e-400\" radius=\"1\"/>\n</hierarchy>", 2, "out of the range"},
+    {"box lost in rounding", H "  <volume type=\"obb\" pos=\"0 1e55 0\" width=\"1\" depth=\"0.06\" height=\"1\"/>\n</hierarchy>", 2,
+     "box extents vanish in rounding"},
+    {"box overflow", H "  <volume type=\"aabb\" pos=\"1.7e308 0 0\" width=\"1.7e308\" depth=\"1\" height=\"1\"/>\n</hierarchy>", 2,
+     "box corners overflow"},
+    {"capsule overflow", H "  <volume type=\"capsule\" pos=\"-1.7e308 0 0\" direction=\"1e-300 0 0\" length=\"1.7e308\" radius=\"1\"/>\n</hierarchy>",
+     2, "capsule ends overflow"},
     {"zero radius", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"0\"/>\n</hierarchy>", 2,
      "'radius' must be > 0, found 0"},
     {"negative radius", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"1 0 0\" length=\"1\" radius=\"-1\"/>\n</hierarchy>",
@@ -417,7 +424,8 @@ TEST(Xml, SurveyAppendixBAsPrintedIsRejectedWithItsLine) {
     // Line 4 has the first OCR damage: `height="1.1"</pre>` inside a start tag.
     EXPECT_EQ(model.error().line, 4) << model.error().to_string();
     EXPECT_NE(model.error().file.find("survey_appendix_b.xml"), std::string::npos);
-    EXPECT_NE(model.error().message.find("malformed XML"), std::string::npos) << model.error().to_string();
+    EXPECT_NE(model.error().message.find("malformed XML: bad start tag"), std::string::npos)
+        << model.error().to_string();
 }
 
 TEST(Xml, SurveyAppendixBRepairedReads) {
