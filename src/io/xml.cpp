@@ -92,7 +92,7 @@ private:
     struct Item {
         BoundingVolume volume;
         std::string name;
-        std::vector<std::uint32_t> children;  ///< Indices into items_, in document order.
+        std::vector<std::uint32_t> children;  ///< Indices of the child items, in document order.
     };
 
     [[nodiscard]] int line_at(std::ptrdiff_t offset) const {
@@ -133,7 +133,9 @@ private:
 
 Result<XmlModel> Reader::run() {
     // Stage 1: parse. Whitespace-only input gets its own message: "no element found" would puzzle.
-    if (is_blank(text_) || text_ == "\xEF\xBB\xBF") return error(1, "file is empty");
+    std::string_view body = text_;
+    if (body.starts_with("\xEF\xBB\xBF")) body.remove_prefix(3);  // a UTF-8 byte order mark
+    if (is_blank(body)) return error(1, "file is empty");
     const pugi::xml_parse_result parsed =
         doc_.load_buffer_inplace(buffer_.data(), buffer_.size(), pugi::parse_default, pugi::encoding_utf8);
     if (!parsed) return error(line_at(parsed.offset), describe_parse_error(parsed));

@@ -254,6 +254,17 @@ TEST(Xml, NestingMakesAHierarchyAndSingleChildVolumesCollapse) {
     EXPECT_TRUE(std::holds_alternative<Sphere>(second.volume));
 }
 
+TEST(Xml, AcceptsAByteOrderMarkAndWindowsLineEnds) {
+    const XmlModel model = read_ok("\xEF\xBB\xBF<?xml version=\"1.0\"?>\r\n<hierarchy>\r\n"
+                                   "  <volume type=\"sphere\" pos=\"0\r\n0 0\" radius=\"1\"/>\r\n</hierarchy>\r\n");
+    EXPECT_EQ(model.primitives.size(), 1u);
+    const Result<XmlModel> bad = read_xml_string("\xEF\xBB\xBF<hierarchy>\r\n\r\n<volume/>\r\n</hierarchy>", "crlf.xml");
+    ASSERT_FALSE(bad);
+    EXPECT_EQ(bad.error().line, 3);
+    EXPECT_FALSE(read_xml_string("\xEF\xBB\xBF \n", "bom.xml").has_value());
+    EXPECT_EQ(read_xml_string("\xEF\xBB\xBF \n", "bom.xml").error().message, "file is empty");
+}
+
 TEST(Xml, FlatSingleVolumeIsAPrimitiveSet) {
     const XmlModel model = read_ok(R"(<hierarchy><volume type="sphere" pos="0 0 0" radius="1"/></hierarchy>)");
     EXPECT_EQ(model.primitives.size(), 1u);
