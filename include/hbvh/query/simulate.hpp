@@ -15,6 +15,7 @@ enum class QueryMethod : std::uint8_t {
     two_level,  ///< collide_two_level(): root test, then every primitive pair (the survey's baseline).
 };
 
+/// Knobs of simulate(); the defaults reproduce the survey's setting (1000 root-overlapping queries).
 struct SimulateOptions {
     std::uint32_t collision_count = 1000;  ///< Queries with overlapping roots to measure (the survey's 1000).
     std::uint64_t seed = 1;                ///< Start states and restarts; same seed, same run (timings aside).
@@ -34,6 +35,7 @@ struct QueryStats {
     double mean_nodes_visited = 0.0;
 };
 
+/// What simulate() measured.
 struct SimulationResult {
     /// The moving case: the first `collision_count` queries whose root BVs overlapped.
     QueryStats moving;
