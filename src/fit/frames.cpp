@@ -185,12 +185,40 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
 SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull) {
     SphereProxy proxy;
     std::vector<bool> taken(spheres.size(), false);
-    for (std::uint32_t i : hull.vertices) taken[i] = true;
+    for (std::uint32_t i : hull.vertices) {
+        taken[i] = true;
+        proxy.hull_points.push_back(spheres[i].center);
+    }
     for (std::size_t i = 0; i < spheres.size(); ++i) {
         if (taken[i] || spheres[i].radius > 0.0) proxy.spheres.push_back(spheres[i]);
         proxy.max_radius = std::max(proxy.max_radius, spheres[i].radius);
     }
     return proxy;
+}
+
+std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> hints, std::size_t limit) {
+    std::vector<Mat3> frames;
+    frames.reserve(hints.size());
+    for (const Mat3& axes : hints) frames.push_back(proper_frame(axes));
+    if (frames.size() <= limit) return frames;
+    std::vector<std::pair<double, std::size_t>> ranked;
+    ranked.reserve(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const Mat3 to_local = frames[i].transpose();
+        Vec3 low = Vec3::Constant(infinity);
+        Vec3 high = Vec3::Constant(-infinity);
+        for (const Vec3& p : proxy.hull_points) {
+            const Vec3 local = to_local * p;
+            low = low.cwiseMin(local);
+            high = high.cwiseMax(local);
+        }
+        ranked.emplace_back((high - low + Vec3::Constant(2.0 * proxy.max_radius)).prod(), i);
+    }
+    std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(limit), ranked.end());
+    std::vector<Mat3> selected;
+    selected.reserve(limit);
+    for (std::size_t i = 0; i < limit; ++i) selected.push_back(frames[ranked[i].second]);
+    return selected;
 }
 
 std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals) {

@@ -16,11 +16,21 @@ namespace hbvh::detail {
 /// extent. Ranking orientations on this subset is therefore exact, yet costs O(hull size) for boxes.
 struct SphereProxy {
     std::vector<Sphere> spheres;
+    std::vector<Vec3> hull_points;  ///< Centres of the hull vertices only: a cheaper, coarser stand-in.
     double max_radius = 0.0;
 };
 
 /// The proxy of `spheres`, whose centres' hull is `hull`.
 [[nodiscard]] SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull);
+
+/// How many hint frames reach the exact ranking; the rest are dropped by a coarse pre-ranking, so that a
+/// node over thousands of differently oriented boxes does not cost (boxes x spheres).
+inline constexpr std::size_t max_ranked_hints = 8;
+
+/// The (at most) `limit` hints, made proper, whose boxes around the hull points padded by the largest
+/// radius (an upper bound, O(hull size) each) are smallest. All of them, in order, when there are few.
+[[nodiscard]] std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> hints,
+                                             std::size_t limit = max_ranked_hints);
 
 /// `axes` made a proper rotation: columns orthonormalised in order (Gram-Schmidt), the last one
 /// completed by a cross product so that det = +1. A column of zero length is replaced by any perpendicular.
@@ -40,8 +50,9 @@ struct SphereProxy {
 
 /// For each unit `normals[i]`, the frame with column 0 along it whose cross-section is the smallest
 /// rectangle around the proxy's projected centres (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
-/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With face normals of the
-/// hull this gives O'Rourke's "one box face flush with a hull face" candidates.
+/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With the hull's face
+/// normals this gives boxes with a face flush with a hull face: a heuristic in the spirit of O'Rourke
+/// 1985 (whose minimal box has two adjacent faces each containing a hull edge), not a guarantee.
 [[nodiscard]] std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals);
 
 /// The smallest box with axes `rotation` containing every sphere exactly (in double arithmetic:

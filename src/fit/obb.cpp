@@ -10,6 +10,7 @@
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
+
 Obb fit_obb_covariance(std::span<const Sphere> spheres) {
     HBVH_ASSERT(!spheres.empty());
     // Gottschalk, Lin & Manocha 1996 (OBBTree, §4): the hull's surface covariance is insensitive to how
@@ -27,7 +28,7 @@ Obb fit_obb(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes) {
     // O(proxy size) each, so that many hints stay cheap.
     std::vector<Mat3> candidates;
     candidates.reserve(hint_axes.size() + 24);
-    for (const Mat3& axes : hint_axes) candidates.push_back(detail::proper_frame(axes));
+    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) candidates.push_back(axes);
     for (const Mat3& axes : detail::dito_frames(spheres)) candidates.push_back(axes);
     // Face-flush frames: along each large hull face normal and each covariance axis (for a flat set the
     // smallest axis is the plane's normal, and the 2-D rectangle step then finds the best in-plane box).
