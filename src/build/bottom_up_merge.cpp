@@ -6,6 +6,7 @@
 #include <iterator>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <queue>
 
 #include "heuristic_support.hpp"
@@ -29,15 +30,15 @@ struct GraphNode {
     std::vector<std::uint32_t> covered;     ///< Local primitive indices, ascending.
     std::vector<std::uint32_t> members;     ///< Assembler ids that become the children of the next group.
     std::vector<std::uint32_t> neighbours;  ///< Graph-node ids, ascending.
-    BoundingVolume volume;
-    double weighted_volume = 0.0;
+    std::optional<BoundingVolume> volume;  ///< fit_best over `covered`; made when first needed.
+    double priced_volume = 0.0;            ///< The node's volume as Eq. 3 sees it (same fitter as the edges).
     bool alive = true;
 };
 
 struct Edge {
     double priority;
     std::uint32_t a, b;  ///< a < b.
-    BoundingVolume merged;  ///< fit_best around both nodes' covered primitives, kept for the collapse.
+    double merged_volume;  ///< Priced volume around both nodes' covered primitives.
 };
 
 // Min-heap order. Ties go to the lower node ids; ids are handed out in an order fixed by geometry
@@ -53,7 +54,7 @@ class MergeBuilder {
 public:
     MergeBuilder(const PrimitiveSet& set, TreeAssembler& assembler, const MergeOptions& options)
         : set_(set), assembler_(assembler), branching_(std::max<std::uint32_t>(options.branching_factor, 2)),
-          enlargement_(options.enlargement > 1.0 ? options.enlargement : 1.25) {}
+          enlargement_(options.enlargement > 1.0 ? options.enlargement : 1.25), exact_(options.exact_priorities) {}
 
     std::uint32_t build() {
         for (std::uint32_t local = 0; local < set_.size(); ++local) {
@@ -61,7 +62,7 @@ public:
             node.covered = {local};
             node.members = {assembler_.add_leaf(set_.input_index(local))};
             node.volume = set_.volume_of(local);
-            node.weighted_volume = set_.primitive_volume(local);
+            node.priced_volume = price(node.covered);
             nodes_.push_back(std::move(node));
         }
         alive_count_ = set_.size();
@@ -74,9 +75,9 @@ public:
         // Stage 2: the last graph-node's pending members become the root group.
         std::uint32_t last = 0;
         while (!nodes_[last].alive) ++last;
-        const GraphNode& root = nodes_[last];
+        GraphNode& root = nodes_[last];
         if (root.members.size() == 1) return root.members.front();
-        return assembler_.add_group(root.members, root.volume);
+        return assembler_.add_group(root.members, volume_of(root));
     }
 
 private:
@@ -92,7 +93,7 @@ private:
         std::vector<Aabb> boxes(count);
         std::vector<bool> connected(count, false);
         const auto grow = [&](std::size_t i) {
-            grown[i] = detail::enlarged(nodes_[live[i]].volume, factor[i]);
+            grown[i] = detail::enlarged(volume_of(nodes_[live[i]]), factor[i]);
             boxes[i] = world_aabb(grown[i]);
         };
         const auto try_pair = [&](std::size_t i, std::size_t j) {
@@ -136,12 +137,12 @@ private:
 
     // Degenerate fallback: the live graph-node with the nearest BV centre, ties to the lower id.
     void connect_nearest(const std::vector<std::uint32_t>& live, std::size_t i, std::vector<bool>& connected) {
-        const Vec3 centre = world_aabb(nodes_[live[i]].volume).center();
+        const Vec3 centre = world_aabb(volume_of(nodes_[live[i]])).center();
         double best = std::numeric_limits<double>::infinity();
         std::size_t nearest = i;
         for (std::size_t j = 0; j < live.size(); ++j) {
             if (j == i) continue;
-            const double d = (world_aabb(nodes_[live[j]].volume).center() - centre).squaredNorm();
+            const double d = (world_aabb(volume_of(nodes_[live[j]])).center() - centre).squaredNorm();
             if (d < best) {
                 best = d;
                 nearest = j;
@@ -176,10 +177,17 @@ private:
         std::vector<std::uint32_t> both;
         std::merge(nodes_[a].covered.begin(), nodes_[a].covered.end(), nodes_[b].covered.begin(),
                    nodes_[b].covered.end(), std::back_inserter(both));
-        BoundingVolume merged = set_.fit(both);
-        const double priority =
-            set_.weighted_volume(merged) - nodes_[a].weighted_volume - nodes_[b].weighted_volume;
-        heap_.push(Edge{priority, a, b, std::move(merged)});
+        const double merged = price(both);
+        heap_.push(Edge{merged - nodes_[a].priced_volume - nodes_[b].priced_volume, a, b, merged});
+    }
+
+    double price(std::span<const std::uint32_t> covered) const {
+        return exact_ ? set_.weighted_volume(set_.fit(covered)) : set_.estimate(covered);
+    }
+
+    const BoundingVolume& volume_of(GraphNode& node) const {
+        if (!node.volume) node.volume = set_.fit(node.covered);
+        return *node.volume;
     }
 
     // Lazy invalidation: an edge is stale once either end has been collapsed into a new graph-node.
@@ -202,8 +210,7 @@ private:
         std::set_union(a.neighbours.begin(), a.neighbours.end(), b.neighbours.begin(), b.neighbours.end(),
                        std::back_inserter(merged.neighbours));
         std::erase_if(merged.neighbours, [&](std::uint32_t id) { return id == edge.a || id == edge.b; });
-        merged.volume = edge.merged;
-        merged.weighted_volume = set_.weighted_volume(merged.volume);
+        merged.priced_volume = edge.merged_volume;
         edge_count_ = edge_count_ + 1 - a.neighbours.size() - b.neighbours.size() + merged.neighbours.size();
 
         const auto id = static_cast<std::uint32_t>(nodes_.size());
@@ -224,7 +231,7 @@ private:
         // graph-node already covers enough BVH nodes or the graph is nearly used up; otherwise the
         // graph-node just carries the union and is grouped in a later collapse.
         if (merged.members.size() >= branching_ || edge_count_ < branching_)
-            merged.members = {assembler_.add_group(merged.members, merged.volume)};
+            merged.members = {assembler_.add_group(merged.members, volume_of(merged))};
         const std::vector<std::uint32_t> neighbours = merged.neighbours;
         nodes_.push_back(std::move(merged));
         for (const std::uint32_t x : neighbours) push_edge(x, id);
@@ -234,6 +241,7 @@ private:
     TreeAssembler& assembler_;
     std::uint32_t branching_;
     double enlargement_;
+    bool exact_;
     std::vector<GraphNode> nodes_;
     std::priority_queue<Edge, std::vector<Edge>, LaterEdge> heap_;
     std::size_t edge_count_ = 0;

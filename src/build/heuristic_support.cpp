@@ -4,11 +4,14 @@
 
 #include <algorithm>
 #include <array>
+#include <limits>
 #include <numeric>
 #include <utility>
 
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
+
+#include <Eigen/Eigenvalues>
 
 namespace hbvh::detail {
 namespace {
@@ -113,14 +116,89 @@ BoundingVolume PrimitiveSet::fit(std::span<const std::uint32_t> locals) const {
     return fit_best(spheres, policy_, hints);
 }
 
-BoundingVolume fit_around(std::span<const BoundingVolume> volumes, const VolumePolicy& policy) {
+double PrimitiveSet::estimate(std::span<const std::uint32_t> locals) const {
+    HBVH_ASSERT(!locals.empty());
+    std::vector<std::uint32_t> sorted(locals.begin(), locals.end());
+    std::sort(sorted.begin(), sorted.end());
     std::vector<Sphere> spheres;
-    std::vector<Mat3> hints;
-    for (const BoundingVolume& bv : volumes) {
-        append_generating_spheres(bv, spheres);
-        if (const Obb* box = std::get_if<Obb>(&bv)) add_hint(hints, box->rotation);
+    std::vector<BoundingVolume> hints;
+    for (const std::uint32_t local : sorted) {
+        const std::span<const Sphere> own = this->spheres(local);
+        spheres.insert(spheres.end(), own.begin(), own.end());
+        const BoundingVolume& bv = volume_of(local);
+        if (!std::holds_alternative<Aabb>(bv) && !std::holds_alternative<Sphere>(bv) && hints.size() < max_hint_boxes)
+            hints.push_back(bv);
     }
-    return fit_best(spheres, policy, hints);
+    return estimate_weighted_volume(spheres, hints, policy_);
+}
+
+namespace {
+
+// Box around the spheres in the frame `rotation` (columns = axes): its volume.
+double box_volume_in(std::span<const Sphere> spheres, const Mat3& rotation) {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 hi = -lo;
+    for (const Sphere& s : spheres) {
+        const Vec3 local = rotation.transpose() * s.center;
+        lo = lo.cwiseMin(local - Vec3::Constant(s.radius));
+        hi = hi.cwiseMax(local + Vec3::Constant(s.radius));
+    }
+    return (hi - lo).prod();
+}
+
+// Capsule on the line through `origin` along unit `axis`: the radius covers every sphere's distance from
+// the line, the segment spans the centres' projections, so every sphere is inside. Its volume.
+double capsule_volume_on(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
+    double radius = 0.0, t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
+    for (const Sphere& s : spheres) {
+        const Vec3 d = s.center - origin;
+        const double t = d.dot(axis);
+        radius = std::max(radius, (d - t * axis).norm() + s.radius);
+        t_min = std::min(t_min, t);
+        t_max = std::max(t_max, t);
+    }
+    return Capsule{origin + t_min * axis, origin + t_max * axis, radius}.volume();
+}
+
+}  // namespace
+
+double estimate_weighted_volume(std::span<const Sphere> spheres, std::span<const BoundingVolume> hints,
+                                const VolumePolicy& policy) {
+    HBVH_ASSERT(!spheres.empty());
+    double best = std::numeric_limits<double>::infinity();
+    const auto consider = [&](BvType type, double v) { best = std::min(best, policy.weight_of(type) * v); };
+    if (policy.is_allowed(BvType::aabb)) consider(BvType::aabb, fit_aabb(spheres).volume());
+    if (policy.is_allowed(BvType::sphere)) consider(BvType::sphere, fit_sphere(spheres).volume());
+    if (!policy.is_allowed(BvType::obb) && !policy.is_allowed(BvType::capsule)) return best;
+
+    // Principal axes of the centres (weighted equally), as Gottschalk's covariance fit but without a hull.
+    Vec3 mean = Vec3::Zero();
+    for (const Sphere& s : spheres) mean += s.center;
+    mean /= static_cast<double>(spheres.size());
+    Mat3 covariance = Mat3::Zero();
+    for (const Sphere& s : spheres) covariance += (s.center - mean) * (s.center - mean).transpose();
+    const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);
+    const Mat3 principal = eigen.eigenvectors();  // columns ascending by eigenvalue; last = main axis
+    if (policy.is_allowed(BvType::obb)) {
+        double v = std::min(box_volume_in(spheres, Mat3::Identity()), box_volume_in(spheres, principal));
+        for (const BoundingVolume& hint : hints)
+            if (const Obb* box = std::get_if<Obb>(&hint)) v = std::min(v, box_volume_in(spheres, box->rotation));
+        consider(BvType::obb, v);
+    }
+    if (policy.is_allowed(BvType::capsule)) {
+        double v = capsule_volume_on(spheres, mean, principal.col(2));
+        for (const BoundingVolume& hint : hints)
+            if (const Capsule* capsule = std::get_if<Capsule>(&hint))
+                v = std::min(v, capsule_volume_on(spheres, capsule->center(), capsule->direction()));
+        consider(BvType::capsule, v);
+    }
+    return best;
+}
+
+double estimate_around(std::span<const BoundingVolume> volumes, const VolumePolicy& policy) {
+    std::vector<Sphere> spheres;
+    for (const BoundingVolume& bv : volumes) append_generating_spheres(bv, spheres);
+    return estimate_weighted_volume(spheres, volumes, policy);
 }
 
 BoundingVolume enlarged(const BoundingVolume& bv, double factor) {

@@ -20,7 +20,7 @@ using detail::Placement;
 
 // Groups expanded per search. Best-first order visits the cheapest regions first, so the cap trims only
 // unpromising branches, and keeps an insertion O(cap) fits however large the tree.
-constexpr std::uint32_t search_limit = 64;
+constexpr std::uint32_t search_limit = 24;
 // A global step must lower the cost by more than this relative amount to be kept (rounding noise).
 constexpr double improvement_tolerance = 1e-12;
 
@@ -39,7 +39,10 @@ struct Frontier {
 // (g keeps its volume V' but has k - 1 fewer children; the new group holds S and the item).
 // Rule 3 pushes each child group with bound + its own growth. Rule 4 can lower the cost, so the bound is
 // exact only for rules 1-3; the search is a heuristic for rule 4, which is why it is capped.
-Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInsertionOptions& options) {
+// `exclude` (a node still in the tree) is skipped as a partner, so a leaf can be priced for re-insertion
+// before it is taken out.
+Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInsertionOptions& options,
+                 std::uint32_t exclude = no_node) {
     const std::uint32_t root = tree.root();
     const double root_grown = tree.estimate_union(root, item);
     Placement best{Placement::Kind::with_child, root, {}, 2.0 * root_grown};
@@ -59,6 +62,7 @@ Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInser
 
         std::vector<std::pair<double, std::uint32_t>> closeness;  // (growth of child if item joined it, child)
         for (const std::uint32_t child : node.children) {
+            if (child == exclude) continue;
             const auto& ch = tree.node(child);
             const double with_item = tree.estimate_union(child, item);
             if (at.bound + 2.0 * with_item < best.cost)
@@ -71,7 +75,7 @@ Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInser
 
         // Rule 4: the item with its k closest children, which lets one insertion create a group wider
         // than two (the survey's complaint about rule 2).
-        const std::size_t c = node.children.size();
+        const std::size_t c = closeness.size();
         if (c < 3) continue;
         std::sort(closeness.begin(), closeness.end());
         std::vector<std::uint32_t> members{item};
@@ -153,15 +157,20 @@ private:
             tree_ = std::move(snapshot);
     }
 
-    // Successive Re-Insertion: leaves whose removal would save the most are the worst placed; take each
-    // out and insert it again with the full search.
+    // Successive Re-Insertion: leaves whose removal would save the most are the worst placed. Each is
+    // priced first with the pricing fitter (removal gain against the best new place, found while the
+    // leaf is still in the tree); only a promising move is carried out with exact refits and kept if
+    // Eq. 2 really dropped.
     void reinsert_leaves() {
         std::vector<std::pair<double, std::uint32_t>> ranked;
         for (const std::uint32_t leaf : tree_.leaves())
             if (tree_.node(leaf).parent != no_node) ranked.emplace_back(-removal_gain(tree_, leaf), leaf);
         std::sort(ranked.begin(), ranked.end());
         if (ranked.size() > options_.max_reinsertions_per_round) ranked.resize(options_.max_reinsertions_per_round);
-        for (const auto& [gain, leaf] : ranked) {
+        for (const auto& [rank, leaf] : ranked) {
+            if (tree_.node(leaf).parent == no_node) continue;
+            const double gain = removal_gain(tree_, leaf);
+            if (!(search(tree_, leaf, options_, leaf).cost < gain - improvement_tolerance * cost_)) continue;
             InsertionTree snapshot = tree_;
             tree_.detach(leaf);
             insert(tree_, leaf, options_);
@@ -177,7 +186,7 @@ private:
             if (id != tree_.root())
                 if (const double score = ill_formed_score(tree_, id, options_); score > 0.0) ranked.emplace_back(-score, id);
         std::sort(ranked.begin(), ranked.end());
-        if (ranked.size() > options_.max_reinsertions_per_round) ranked.resize(options_.max_reinsertions_per_round);
+        if (ranked.size() > options_.max_eliminations_per_round) ranked.resize(options_.max_eliminations_per_round);
         for (const auto& [score, id] : ranked) {
             if (!is_live_group(tree_, id) || id == tree_.root() || ill_formed_score(tree_, id, options_) == 0.0)
                 continue;

@@ -31,14 +31,14 @@ std::uint32_t InsertionTree::new_group() {
 
 double InsertionTree::estimate_union(std::uint32_t a, std::uint32_t b) const {
     const BoundingVolume both[2] = {nodes_[a].volume, nodes_[b].volume};
-    return set_->weighted_volume(fit_around(both, set_->policy()));
+    return detail::estimate_around(both, set_->policy());
 }
 
 double InsertionTree::estimate_around(std::span<const std::uint32_t> ids) const {
     std::vector<BoundingVolume> volumes;
     volumes.reserve(ids.size());
     for (const std::uint32_t id : ids) volumes.push_back(nodes_[id].volume);
-    return set_->weighted_volume(fit_around(volumes, set_->policy()));
+    return detail::estimate_around(volumes, set_->policy());
 }
 
 void InsertionTree::collect_primitives(std::uint32_t id, std::vector<std::uint32_t>& out) const {

@@ -48,8 +48,8 @@ public:
     [[nodiscard]] std::uint32_t root() const { return root_; }
     [[nodiscard]] const PrimitiveSet& primitives() const { return *set_; }
 
-    /// Weighted volume of fit_best around the BVs of `a` and `b`: the cheap estimate of "a with b added"
-    /// (never smaller than either, since it contains both).
+    /// Weighted volume of the pricing fitter (estimate_weighted_volume) around the BVs of `a` and `b`:
+    /// the cheap estimate of "a with b added".
     [[nodiscard]] double estimate_union(std::uint32_t a, std::uint32_t b) const;
     /// As estimate_union, around the BVs of `ids`.
     [[nodiscard]] double estimate_around(std::span<const std::uint32_t> ids) const;

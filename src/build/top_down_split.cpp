@@ -105,9 +105,9 @@ private:
     // Sorts `locals` along the best axis and returns the size of the left part (1..size-1).
     std::size_t choose_cut(std::vector<std::uint32_t>& locals) {
         const std::size_t count = locals.size();
-        const bool exact = count <= options_.exact_cost_limit;
+        const bool per_side = count <= options_.per_side_pricing_limit;
         Obb frame;
-        if (!exact) {
+        if (!per_side) {
             std::vector<Sphere> spheres;
             for (const std::uint32_t local : locals) {
                 const auto own = set_.spheres(local);
@@ -121,7 +121,7 @@ private:
         std::vector<double> prefix(count), suffix(count);
         for (int axis = 0; axis < 3; ++axis) {
             sort_along(locals, axis);
-            side_volumes(locals, exact, frame, prefix, suffix);
+            side_volumes(locals, per_side, frame, prefix, suffix);
             for (std::size_t left = 1; left < count; ++left) {
                 const double cost = static_cast<double>(left) * prefix[left - 1] +
                                     static_cast<double>(count - left) * suffix[left];
@@ -146,13 +146,13 @@ private:
     }
 
     // prefix[i]: weighted volume around locals[0..i]; suffix[i]: around locals[i..end).
-    void side_volumes(const std::vector<std::uint32_t>& locals, bool exact, const Obb& frame,
+    void side_volumes(const std::vector<std::uint32_t>& locals, bool per_side, const Obb& frame,
                       std::vector<double>& prefix, std::vector<double>& suffix) const {
         const std::size_t count = locals.size();
-        if (exact) {
+        if (per_side) {
             for (std::size_t i = 0; i < count; ++i) {
-                prefix[i] = set_.weighted_volume(set_.fit(std::span(locals).first(i + 1)));
-                suffix[i] = set_.weighted_volume(set_.fit(std::span(locals).subspan(i)));
+                prefix[i] = set_.estimate(std::span(locals).first(i + 1));
+                suffix[i] = set_.estimate(std::span(locals).subspan(i));
             }
             return;
         }

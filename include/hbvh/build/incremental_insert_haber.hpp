@@ -17,9 +17,12 @@ struct HaberInsertionOptions {
     std::uint32_t max_rule4_children = 6;
     /// Rounds of global optimisation (Successive Re-Insertion, then Elimination of Ill-formed Groups);
     /// a round that does not lower the cost ends the optimisation early.
-    std::uint32_t optimization_rounds = 3;
-    /// Successive Re-Insertion tries at most this many leaves per round, worst placed first.
+    std::uint32_t optimization_rounds = 2;
+    /// Successive Re-Insertion prices at most this many leaves per round, worst placed first.
     std::uint32_t max_reinsertions_per_round = 256;
+    /// Elimination of Ill-formed Groups tries at most this many groups per round, loosest first
+    /// (each try refits exactly, so this bounds the optimisation's cost).
+    std::uint32_t max_eliminations_per_round = 8;
     /// Ill-formed group: Eq. 1 tightness (volume / sum of children's volumes) above this ...
     double max_tightness = 3.0;
     /// ... or a child whose volume is at least this fraction of the group's volume.

@@ -13,10 +13,11 @@ namespace hbvh {
 
 /// Knobs of build_top_down_split. See docs/algorithms-heuristics.md.
 struct SplitOptions {
-    /// Nodes with at most this many primitives price each candidate cut with fit_best on both sides;
-    /// larger nodes use the cheap incremental estimate (exact AABB, OBB in the node's covariance frame,
-    /// grown sphere, capsule on the node's main axis), so a sweep stays linear. 0: always the estimate.
-    std::uint32_t exact_cost_limit = 24;
+    /// Nodes with at most this many primitives price each side of each cut with the pricing fitter
+    /// around that side alone (exact AABB and sphere, OBB and capsule in the side's own principal frame);
+    /// larger nodes use running bounds in the node's covariance frame (exact AABB, OBB in that frame,
+    /// grown sphere, capsule on its main axis), so a sweep stays linear. 0: always the running bounds.
+    std::uint32_t per_side_pricing_limit = 64;
 };
 
 /// Binary hierarchy by recursive two-way cuts. At every node the primitives are sorted by the centre of
