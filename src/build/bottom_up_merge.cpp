@@ -10,12 +10,7 @@
 #include <queue>
 
 #include "heuristic_support.hpp"
-// The exact BV-BV test comes from branch `query`; until it is merged the world boxes of the enlarged BVs
-// stand in (a superset of the exact edges).
-#if __has_include("hbvh/geometry/overlap.hpp")
 #include "hbvh/geometry/overlap.hpp"
-#define HBVH_MERGE_EXACT_OVERLAP 1
-#endif
 
 namespace hbvh {
 namespace {
@@ -100,9 +95,7 @@ private:
             const Aabb& p = boxes[i];
             const Aabb& q = boxes[j];
             if ((p.min.array() > q.max.array()).any() || (q.min.array() > p.max.array()).any()) return;
-#ifdef HBVH_MERGE_EXACT_OVERLAP
             if (!overlaps(grown[i], grown[j])) return;
-#endif
             add_edge(live[i], live[j]);
             connected[i] = connected[j] = true;
         };

@@ -21,6 +21,10 @@ using detail::Placement;
 // Groups expanded per search. Best-first order visits the cheapest regions first, so the cap trims only
 // unpromising branches, and keeps an insertion O(cap) fits however large the tree.
 constexpr std::uint32_t search_limit = 24;
+// A re-insertion is carried out only if the pricing fitter expects it to save this fraction of the
+// total cost: the estimates are upper bounds of differing looseness, and a move that is only
+// predicted to break even is almost always reverted after its (costly) exact refits.
+constexpr double promising_gain = 1e-3;
 // A global step must lower the cost by more than this relative amount to be kept (rounding noise).
 constexpr double improvement_tolerance = 1e-12;
 
@@ -170,7 +174,7 @@ private:
         for (const auto& [rank, leaf] : ranked) {
             if (tree_.node(leaf).parent == no_node) continue;
             const double gain = removal_gain(tree_, leaf);
-            if (!(search(tree_, leaf, options_, leaf).cost < gain - improvement_tolerance * cost_)) continue;
+            if (!(search(tree_, leaf, options_, leaf).cost < gain - promising_gain * cost_)) continue;
             InsertionTree snapshot = tree_;
             tree_.detach(leaf);
             insert(tree_, leaf, options_);
