@@ -14,12 +14,15 @@ namespace hbvh {
 /// Knobs of build_bottom_up_merge. See docs/algorithms-heuristics.md.
 struct MergeOptions {
     /// Merge postponement (survey §2.3): a collapse becomes a BVH group only once the graph-node covers at
-    /// least this many BVH nodes, or fewer edges than this remain. Groups therefore get between
-    /// `branching_factor` and `2 x branching_factor - 2` children (fewer only near the root).
-    /// Default 4: Eq. 2 charges every child with the parent's volume, so wide nodes pay only when their
-    /// volume is small, and 4 gives short trees (the survey's "small and fat") with a few children per
-    /// overlap test, like the quad/oct trees collision engines favour. Values below 2 act as 2.
-    std::uint32_t branching_factor = 4;
+    /// least this many BVH nodes, or fewer edges than this remain; otherwise the graph-node carries the
+    /// union and is grouped in a later collapse. Groups get between `branching_factor` and
+    /// `2 x branching_factor - 2` children (fewer only at the root). Values below 2 act as 2.
+    /// Default 2, OpenTissue's own default degree: on our generated scenes and bundled models it gave the
+    /// lowest Eq. 2 cost (geometric mean vs two-level 0.163 at 2, 0.188 at 3, 0.199 at 4, 0.238 at 8;
+    /// docs/algorithms-heuristics.md): Eq. 2 charges every child with its parent's volume, and on these
+    /// inputs the levels saved by wider groups did not pay for that. At 2 every collapse makes a group (plain binary agglomeration); raise it for the survey's
+    /// "small and fat" trees.
+    std::uint32_t branching_factor = 2;
     /// Graph edges join primitives whose BVs, scaled about their centres by this factor in every linear
     /// dimension, overlap (the survey's 25 %). Nodes left without an edge are scaled by it again, and again.
     double enlargement = 1.25;

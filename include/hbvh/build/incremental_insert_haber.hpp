@@ -17,7 +17,7 @@ struct HaberInsertionOptions {
     std::uint32_t max_rule4_children = 6;
     /// Rounds of global optimisation (Successive Re-Insertion, then Elimination of Ill-formed Groups);
     /// a round that does not lower the cost ends the optimisation early.
-    std::uint32_t optimization_rounds = 2;
+    std::uint32_t optimization_rounds = 1;
     /// Successive Re-Insertion prices at most this many leaves per round, worst placed first.
     std::uint32_t max_reinsertions_per_round = 256;
     /// Elimination of Ill-formed Groups tries at most this many groups per round, loosest first
