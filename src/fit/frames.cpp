@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Candidate orientations (principal axes, DiTO frames, local refinement) and per-frame box evaluation.
+// Candidate orientations (principal axes, DiTO, face-flush, local refinement) and per-frame box evaluation.
 #include "frames.hpp"
 
 #include <algorithm>
@@ -73,7 +73,8 @@ Mat3 proper_frame(const Mat3& axes) {
     x = x.norm() > 0.0 ? Vec3(x.normalized()) : Vec3::UnitX();
     Vec3 y = axes.col(1) - axes.col(1).dot(x) * x;
     // A column that is (nearly) parallel to the first carries no orientation; pick any perpendicular.
-    y = y.norm() > 1e-12 * std::max(1.0, axes.col(1).norm()) ? Vec3(y.normalized()) : any_perpendicular(x);
+    // The test is relative: callers pass unnormalised cross products, tiny for tiny inputs.
+    y = y.norm() > 1e-12 * axes.col(1).norm() ? Vec3(y.normalized()) : any_perpendicular(x);
     Mat3 frame;
     frame.col(0) = x;
     frame.col(1) = y;
