@@ -10,6 +10,7 @@
 #include <queue>
 
 #include "heuristic_support.hpp"
+#include "hbvh/assert.hpp"
 #include "hbvh/geometry/overlap.hpp"
 
 namespace hbvh {
@@ -186,6 +187,7 @@ private:
     // Lazy invalidation: an edge is stale once either end has been collapsed into a new graph-node.
     Edge pop_live_edge() {
         while (true) {
+            HBVH_ASSERT(!heap_.empty());  // edge_count_ > 0 means a live edge is queued
             Edge edge = heap_.top();
             heap_.pop();
             if (nodes_[edge.a].alive && nodes_[edge.b].alive) return edge;

@@ -8,10 +8,10 @@
 #include <numeric>
 #include <utility>
 
+#include <Eigen/Eigenvalues>
+
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
-
-#include <Eigen/Eigenvalues>
 
 namespace hbvh::detail {
 namespace {

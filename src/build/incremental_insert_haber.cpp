@@ -6,6 +6,7 @@
 #include "hbvh/build/incremental_insert_haber.hpp"
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <queue>
 
