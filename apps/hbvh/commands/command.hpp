@@ -1,0 +1,61 @@
+// SPDX-License-Identifier: MIT
+// What every subcommand shares: how it registers, how it reads its input and writes its output,
+// and how errors become messages and exit codes (0 ok, 1 bad input, 2 bad usage).
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "hbvh/build/build.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh::cli {
+
+inline constexpr int exit_ok = 0;
+inline constexpr int exit_bad_input = 1;
+inline constexpr int exit_bad_usage = 2;
+
+/// The action a subcommand's parse selected; run after parsing succeeds.
+using Command = std::function<int()>;
+
+/// Each subcommand adds itself to `app` and, when chosen, stores its action in `command`.
+void add_algorithms_command(CLI::App& app, Command& command);
+void add_build_command(CLI::App& app, Command& command);
+void add_stats_command(CLI::App& app, Command& command);
+void add_generate_command(CLI::App& app, Command& command);
+void add_compare_command(CLI::App& app, Command& command);
+
+/// A loaded input: always the primitives; the hierarchy too when the file nests volumes.
+struct Model {
+    std::vector<Primitive> primitives;
+    std::optional<Bvh> hierarchy;
+    std::vector<std::string> warnings;
+};
+
+/// Reads INPUT ("-" = stdin) in the format its extension says, or `format` when given.
+[[nodiscard]] Result<Model> load_model(const std::string& path, const std::string& format = {});
+/// Writes `content` to `path` atomically, or to stdout for "-".
+[[nodiscard]] Status write_output(const std::string& path, const std::string& content);
+/// Prints "hbvh: <where>: <message>" to stderr and returns exit_bad_input.
+int report_error(const Error& error);
+/// Prints warnings to stderr, one a line.
+void report_warnings(const std::vector<std::string>& warnings);
+
+/// Options that select and steer a builder, shared by build, stats, compare, collide.
+struct BuilderFlags {
+    std::string algorithm = "two-level";
+    std::string types = "aabb,obb,sphere,capsule";
+    std::string type_weights;
+    void add_to(CLI::App& command);
+    /// The algorithm and options, or a usage Error.
+    [[nodiscard]] Result<std::pair<Algorithm, BuildOptions>> resolve() const;
+};
+
+/// The model's hierarchy, or one built from its primitives with `flags`.
+[[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags);
+
+}  // namespace hbvh::cli

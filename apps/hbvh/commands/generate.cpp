@@ -1,0 +1,30 @@
+// SPDX-License-Identifier: MIT
+// `hbvh generate`: a seeded random primitive set, for tests and benchmarks of any size.
+#include "commands/command.hpp"
+#include "hbvh/io/xml.hpp"
+#include "hbvh/scene/generate.hpp"
+
+namespace hbvh::cli {
+
+void add_generate_command(CLI::App& app, Command& command) {
+    auto options = std::make_shared<SceneOptions>();
+    auto output = std::make_shared<std::string>("-");
+    auto uniform = std::make_shared<bool>(false);
+    CLI::App* sub = app.add_subcommand("generate", "Write a seeded random set of primitives (survey XML)");
+    sub->add_option("--count", options->count, "Number of primitives")->capture_default_str()->check(CLI::Range(1u, 100000000u));
+    sub->add_option("--seed", options->seed, "Random seed")->capture_default_str();
+    sub->add_flag("--uniform", *uniform, "Scatter uniformly instead of in clusters");
+    sub->add_option("-o,--output", *output, "Output file, or - for stdout")->capture_default_str();
+    sub->footer("Example: hbvh generate --count 1000 --seed 7 -o scene.xml");
+    sub->callback([&command, options, output, uniform] {
+        command = [options, output, uniform] {
+            options->clustered = !*uniform;
+            const std::vector<Primitive> primitives = generate_scene(*options);
+            if (Status written = write_output(*output, write_primitives_xml(primitives)); !written)
+                return report_error(written.error());
+            return exit_ok;
+        };
+    });
+}
+
+}  // namespace hbvh::cli

@@ -1,0 +1,79 @@
+// SPDX-License-Identifier: MIT
+// `hbvh stats`: the survey's quality measures of a hierarchy (or of one built from a primitive set).
+#include <fmt/core.h>
+
+#include <nlohmann/json.hpp>
+
+#include "commands/command.hpp"
+#include "hbvh/tree/stats.hpp"
+
+namespace hbvh::cli {
+namespace {
+struct StatsArguments {
+    std::string input;
+    std::string format;
+    BuilderFlags builder;
+    bool json = false;
+};
+
+nlohmann::json to_json(const Summary& summary) {
+    return {{"min", summary.min}, {"mean", summary.mean}, {"max", summary.max}};
+}
+
+nlohmann::json to_json(const Stats& stats) {
+    nlohmann::json types;
+    for (BvType type : all_bv_types) types[std::string(to_string(type))] = stats.types[static_cast<std::size_t>(type)];
+    return {{"cost", stats.cost},
+            {"height", stats.height},
+            {"nodes", stats.nodes},
+            {"inner_nodes", stats.inner_nodes},
+            {"leaves", stats.leaves},
+            {"branching", to_json(stats.branching)},
+            {"tightness", to_json(stats.tightness)},
+            {"leaf_depth", to_json(stats.leaf_depth)},
+            {"overlap", stats.overlap},
+            {"types", types}};
+}
+
+void print_text(const Stats& stats) {
+    const auto line = [](const char* name, const Summary& s) {
+        fmt::print("{:<12} min {:.4g}  mean {:.4g}  max {:.4g}\n", name, s.min, s.mean, s.max);
+    };
+    fmt::print("{:<12} {:.6g}\n", "cost", stats.cost);
+    fmt::print("{:<12} {}\n", "height", stats.height);
+    fmt::print("{:<12} {} ({} inner, {} leaves)\n", "nodes", stats.nodes, stats.inner_nodes, stats.leaves);
+    line("branching", stats.branching);
+    line("tightness", stats.tightness);
+    line("leaf depth", stats.leaf_depth);
+    fmt::print("{:<12} {:.4g}\n", "overlap", stats.overlap);
+    fmt::print("{:<12} aabb {}  obb {}  sphere {}  capsule {}\n", "types", stats.types[0], stats.types[1], stats.types[2],
+               stats.types[3]);
+}
+
+int run_stats(const StatsArguments& args) {
+    Result<Model> model = load_model(args.input, args.format);
+    if (!model) return report_error(model.error());
+    report_warnings(model->warnings);
+    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    if (!bvh) return report_error(bvh.error());
+    const Stats stats = compute_stats(bvh.value());
+    if (args.json)
+        fmt::print("{}\n", to_json(stats).dump(2));
+    else
+        print_text(stats);
+    return exit_ok;
+}
+}  // namespace
+
+void add_stats_command(CLI::App& app, Command& command) {
+    auto args = std::make_shared<StatsArguments>();
+    CLI::App* sub = app.add_subcommand("stats", "Quality measures of a hierarchy (cost Eq. 2, tightness Eq. 1, shape)");
+    sub->add_option("file", args->input, "Hierarchy file, or a primitive set (built first with -a)")->required();
+    sub->add_option("--format", args->format, "Input format when the extension does not tell");
+    args->builder.add_to(*sub);
+    sub->add_flag("--json", args->json, "Print JSON with the keys listed in docs/metrics.md");
+    sub->footer("Example: hbvh stats chair.hbvh.xml --json");
+    sub->callback([&command, args] { command = [args] { return run_stats(*args); }; });
+}
+
+}  // namespace hbvh::cli

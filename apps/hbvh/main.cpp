@@ -1,0 +1,27 @@
+// SPDX-License-Identifier: MIT
+// hbvh: builds and queries heterogeneous bounding-volume hierarchies from the command line.
+#include <CLI/CLI.hpp>
+#include <cstdio>
+
+#include "commands/command.hpp"
+
+int main(int argc, char** argv) {
+    using namespace hbvh::cli;
+    CLI::App app{"hbvh: builds heterogeneous bounding-volume hierarchies (AABB, OBB, sphere, capsule) over\n"
+                 "primitive volumes, measures them, and answers collision queries with them."};
+    app.set_version_flag("--version", std::string("hbvh ") + HBVH_VERSION);
+    app.require_subcommand(1);
+    Command command;
+    add_algorithms_command(app, command);
+    add_build_command(app, command);
+    add_stats_command(app, command);
+    add_generate_command(app, command);
+    add_compare_command(app, command);
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::ParseError& error) {
+        // --help and --version arrive here too, with exit code 0.
+        return app.exit(error) == 0 ? exit_ok : exit_bad_usage;
+    }
+    return command ? command() : exit_bad_usage;
+}

@@ -1,0 +1,84 @@
+// SPDX-License-Identifier: MIT
+#include "hbvh/tree/stats.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace hbvh {
+namespace {
+/// Accumulates min / mean / max.
+class SummaryBuilder {
+public:
+    void add(double value) {
+        min_ = std::min(min_, value);
+        max_ = std::max(max_, value);
+        sum_ += value;
+        ++count_;
+    }
+    [[nodiscard]] Summary summary() const {
+        if (count_ == 0) return {};
+        return {min_, sum_ / static_cast<double>(count_), max_};
+    }
+
+private:
+    double min_ = std::numeric_limits<double>::infinity();
+    double max_ = -std::numeric_limits<double>::infinity();
+    double sum_ = 0.0;
+    std::uint64_t count_ = 0;
+};
+
+double intersection_volume(const Aabb& a, const Aabb& b) {
+    const Vec3 lo = a.min.cwiseMax(b.min);
+    const Vec3 hi = a.max.cwiseMin(b.max);
+    return (hi - lo).cwiseMax(Vec3::Zero()).prod();
+}
+}  // namespace
+
+double cost(const Bvh& bvh, const VolumePolicy& policy) {
+    double total = 0.0;
+    for (const Node& node : bvh.nodes)
+        if (!node.is_leaf()) total += node.child_count * policy.weighted_volume(node.volume);
+    return total;
+}
+
+Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
+    Stats stats;
+    stats.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
+    stats.cost = cost(bvh, policy);
+    SummaryBuilder branching, tightness, leaf_depth;
+    double overlap_volume = 0.0, sibling_volume = 0.0;
+
+    // Depths follow from the breadth-first layout: a child is deeper than its parent by one.
+    std::vector<std::uint32_t> depth(bvh.nodes.size(), 0);
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const Node& node = bvh.nodes[i];
+        ++stats.types[static_cast<std::size_t>(type_of(node.volume))];
+        stats.height = std::max(stats.height, depth[i]);
+        if (node.is_leaf()) {
+            ++stats.leaves;
+            leaf_depth.add(depth[i]);
+            continue;
+        }
+        ++stats.inner_nodes;
+        branching.add(node.child_count);
+        double children_volume = 0.0;
+        for (std::uint32_t c = 0; c < node.child_count; ++c) {
+            const Node& child = bvh.nodes[node.first_child + c];
+            depth[node.first_child + c] = depth[i] + 1;
+            children_volume += volume(child.volume);
+            // Sibling overlap: pairwise intersection of the children's world AABBs (docs/metrics.md).
+            const Aabb child_box = world_aabb(child.volume);
+            sibling_volume += child_box.volume();
+            for (std::uint32_t d = c + 1; d < node.child_count; ++d)
+                overlap_volume += intersection_volume(child_box, world_aabb(bvh.nodes[node.first_child + d].volume));
+        }
+        if (children_volume > 0.0) tightness.add(volume(node.volume) / children_volume);
+    }
+    stats.branching = branching.summary();
+    stats.tightness = tightness.summary();
+    stats.leaf_depth = leaf_depth.summary();
+    stats.overlap = sibling_volume > 0.0 ? overlap_volume / sibling_volume : 0.0;
+    return stats;
+}
+
+}  // namespace hbvh
