@@ -9,6 +9,8 @@ namespace hbvh {
 namespace {
 constexpr std::array registry{
     AlgorithmInfo{Algorithm::two_level, "two-level", "the survey's baseline: one root BV (best allowed type) over all primitives"},
+    AlgorithmInfo{Algorithm::bnb_tightest, "bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound"},
+    AlgorithmInfo{Algorithm::bnb_enlarge, "bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound"},
 };
 }  // namespace
 
@@ -30,6 +32,10 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
     switch (algorithm) {
         case Algorithm::two_level: return build_two_level(primitives, options.policy);
+        case Algorithm::bnb_tightest:
+            return build_bnb_tightest(primitives, options.policy, options.branch_and_bound, options.report);
+        case Algorithm::bnb_enlarge:
+            return build_bnb_enlarge(primitives, options.policy, options.branch_and_bound, options.report);
     }
     return Error{"unknown algorithm", "", 0};
 }

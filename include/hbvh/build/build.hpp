@@ -7,6 +7,7 @@
 #include <span>
 #include <string_view>
 
+#include "hbvh/build/branch_and_bound.hpp"
 #include "hbvh/build/report.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/result.hpp"
@@ -16,6 +17,8 @@ namespace hbvh {
 
 enum class Algorithm {
     two_level,
+    bnb_tightest,
+    bnb_enlarge,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -34,6 +37,7 @@ struct AlgorithmInfo {
 struct BuildOptions {
     VolumePolicy policy;
     BuildReport* report = nullptr;  ///< Filled when non-null.
+    BranchAndBoundOptions branch_and_bound;  ///< bnb-tightest, bnb-enlarge.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
