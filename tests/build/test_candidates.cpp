@@ -37,13 +37,15 @@ TEST(TightestCandidates, GrowsByEq1FromEveryNode) {
     for (double x : {0.0, 1.5, 4.0, 9.0}) primitives.push_back({Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, ""});
     const Level level = make_level(primitives, VolumePolicy::only(BvType::aabb));
     const auto sets = tightest_candidates(level);
-    ASSERT_EQ(sets.size(), 4u * 3u);
+    // Start 1 reaches {0,1}, already grown through from start 0, and stops; start 2 stops at {0,1,2}.
+    ASSERT_EQ(sets.size(), 6u);
     EXPECT_EQ(sets[0], (std::vector<std::uint32_t>{0, 1}));
     EXPECT_EQ(sets[1], (std::vector<std::uint32_t>{0, 1, 2}));
     EXPECT_EQ(sets[2], (std::vector<std::uint32_t>{0, 1, 2, 3}));
     // From node 3 (x = 9): nearest is node 2, then 1, then 0.
-    EXPECT_EQ(sets[9], (std::vector<std::uint32_t>{2, 3}));
-    EXPECT_EQ(sets[10], (std::vector<std::uint32_t>{1, 2, 3}));
+    EXPECT_EQ(sets[3], (std::vector<std::uint32_t>{1, 2}));
+    EXPECT_EQ(sets[4], (std::vector<std::uint32_t>{2, 3}));
+    EXPECT_EQ(sets[5], (std::vector<std::uint32_t>{1, 2, 3}));
     EXPECT_EQ(normalised(sets).size(), 6u);  // {0,1} {0,1,2} {0..3} {1,2} {1,2,3} {2,3}
 }
 
