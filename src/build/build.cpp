@@ -14,6 +14,8 @@ constexpr std::array registry{
     AlgorithmInfo{Algorithm::insertion_haber, "insertion-haber", "insertion with Haber et al.'s extra rule, re-insertion and ill-formed-group elimination (survey 2.1)"},
     AlgorithmInfo{Algorithm::split, "split", "Mueller et al. top-down split at the cheapest sorted cut on x, y or z (survey 2.2)"},
     AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)"},
+    AlgorithmInfo{Algorithm::bnb_tightest, "bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound"},
+    AlgorithmInfo{Algorithm::bnb_enlarge, "bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound"},
 };
 }  // namespace
 
@@ -41,6 +43,10 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
             return build_incremental_insert_haber(primitives, options.policy, options.insertion_haber);
         case Algorithm::split: return build_top_down_split(primitives, options.policy, options.split);
         case Algorithm::obb_tree: return build_obb_tree(primitives, options.policy, options.obb_tree);
+        case Algorithm::bnb_tightest:
+            return build_bnb_tightest(primitives, options.policy, options.branch_and_bound, options.report);
+        case Algorithm::bnb_enlarge:
+            return build_bnb_enlarge(primitives, options.policy, options.branch_and_bound, options.report);
     }
     return Error{"unknown algorithm", "", 0};
 }

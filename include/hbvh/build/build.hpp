@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "hbvh/build/bottom_up_merge.hpp"
+#include "hbvh/build/branch_and_bound.hpp"
 #include "hbvh/build/incremental_insert.hpp"
 #include "hbvh/build/incremental_insert_haber.hpp"
 #include "hbvh/build/obb_tree.hpp"
@@ -26,6 +27,8 @@ enum class Algorithm {
     insertion_haber,
     split,
     obb_tree,
+    bnb_tightest,
+    bnb_enlarge,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -49,6 +52,7 @@ struct BuildOptions {
     HaberInsertionOptions insertion_haber;  ///< For Algorithm::insertion_haber.
     SplitOptions split;              ///< For Algorithm::split.
     ObbTreeOptions obb_tree;         ///< For Algorithm::obb_tree.
+    BranchAndBoundOptions branch_and_bound;  ///< bnb-tightest, bnb-enlarge.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
