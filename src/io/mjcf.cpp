@@ -29,10 +29,11 @@ struct FoundAttribute {
     pugi::xml_node element;
 };
 
-// One <default class> level: its parent class and its <geom> defaults (null node when it has none).
+// One <default class> level: its parent class and its <geom> defaults, later ones overriding earlier ones
+// (several top-level <default> elements, e.g. from includes, all add to class "main").
 struct DefaultClass {
     std::string parent;
-    pugi::xml_node geom;
+    std::vector<pugi::xml_node> geoms;
 };
 
 struct CompilerSettings {
@@ -58,13 +59,15 @@ public:
         if (Status status = for_each_child(root, [&](pugi::xml_node child) { return read_top_level(child); });
             !status)
             return status.error();
-        // Stage 2: the body tree, in document order (several <worldbody> elements concatenate, as in MuJoCo).
+        // Stage 2: the body tree. Several <worldbody> elements (e.g. from includes) form one world body, as in MuJoCo.
+        std::vector<pugi::xml_node> world_parts;
         if (Status status = for_each_child(root, [&](pugi::xml_node child) -> Status {
-                if (std::string_view(child.name()) != "worldbody") return Ok{};
-                return read_body(child, RigidTransform::identity(), "", true);
+                if (std::string_view(child.name()) == "worldbody") world_parts.push_back(child);
+                return Ok{};
             });
             !status)
             return status.error();
+        if (Status status = read_body(world_parts, RigidTransform::identity(), "", true); !status) return status.error();
         return std::move(result_);
     }
 
@@ -145,12 +148,13 @@ private:
         const bool top_level = parent.empty();
         std::string name = element.attribute("class").as_string(top_level ? "main" : "");
         if (name.empty()) return error_at(element, "nested <default> without a class attribute");
-        if (classes_.contains(name)) return error_at(element, "default class '" + name + "' is defined twice");
+        if (classes_.contains(name) && !top_level)
+            return error_at(element, "default class '" + name + "' is defined twice");
         classes_[name].parent = parent;
         return for_each_child(element, [&](pugi::xml_node child) -> Status {
             const std::string_view child_name = child.name();
             if (child_name == "default") return read_default(child, name);
-            if (child_name == "geom") classes_[name].geom = child;
+            if (child_name == "geom") classes_[name].geoms.push_back(child);
             return Ok{};
         });
     }
@@ -177,10 +181,18 @@ private:
                                          const char* name) {
         if (const pugi::xml_attribute own = geom.attribute(name)) return {own.value(), geom};
         for (const DefaultClass* level : chain)
-            if (level->geom)
-                if (const pugi::xml_attribute inherited = level->geom.attribute(name))
-                    return {inherited.value(), level->geom};
+            for (auto geom_default = level->geoms.rbegin(); geom_default != level->geoms.rend(); ++geom_default)
+                if (const pugi::xml_attribute inherited = geom_default->attribute(name))
+                    return {inherited.value(), *geom_default};
         return {};
+    }
+
+    // The element, then every <geom> default of its class chain, most specific first.
+    static std::vector<pugi::xml_node> levels_of(const pugi::xml_node& element,
+                                                 const std::vector<const DefaultClass*>& chain) {
+        std::vector<pugi::xml_node> levels{element};
+        for (const DefaultClass* level : chain) levels.insert(levels.end(), level->geoms.rbegin(), level->geoms.rend());
+        return levels;
     }
 
     // Parses exactly `count` numbers (or between `count` and `max_count`) from an attribute.
@@ -199,13 +211,12 @@ private:
 
     double to_radians(double angle) const { return compiler_.degrees ? angle * std::numbers::pi / 180.0 : angle; }
 
-    // Reads the orientation of an element: the most specific level that gives any of the five forms wins whole
-    // (a geom's own quat replaces a default's euler, rather than mixing with it).
+    // Reads the orientation of an element: the most specific level that gives any of the five forms wins whole,
+    // so a geom's own quat replaces a class's euler. Recent MuJoCo sources do the same; MuJoCo 2.2.2 instead
+    // lets a class's euler/axisangle/xyaxes/zaxis beat the geom's own quat (see docs/importers.md).
     Result<Mat3> orientation(const pugi::xml_node& element, const std::vector<const DefaultClass*>& chain) {
         static constexpr std::array<const char*, 5> forms{"quat", "axisangle", "xyaxes", "zaxis", "euler"};
-        std::vector<pugi::xml_node> levels{element};
-        for (const DefaultClass* level : chain)
-            if (level->geom) levels.push_back(level->geom);
+        const std::vector<pugi::xml_node> levels = levels_of(element, chain);
         for (const pugi::xml_node& level : levels) {
             const char* form = nullptr;
             for (const char* candidate : forms) {
@@ -263,8 +274,10 @@ private:
 
     // One body: its geoms first (including those inside <frame>s), then its child bodies, which reproduces
     // MuJoCo's geom order (bodies in depth-first order, geoms in document order within a body).
-    Status read_body(const pugi::xml_node& body, const RigidTransform& world_from_parent, std::string child_class,
-                     bool is_world) {
+    // `parts` is one <body>, or every <worldbody> of the model for the world body.
+    Status read_body(const std::vector<pugi::xml_node>& parts, const RigidTransform& world_from_parent,
+                     std::string child_class, bool is_world) {
+        const pugi::xml_node body = parts.front();
         RigidTransform world_from_body = world_from_parent;
         std::string body_name = "world";
         const int body_id = body_count_++;
@@ -309,9 +322,10 @@ private:
                 return Ok{};
             });
         };
-        if (Status status = walk(body, world_from_body, child_class); !status) return status;
+        for (const pugi::xml_node& part : parts)
+            if (Status status = walk(part, world_from_body, child_class); !status) return status;
         for (const PendingBody& child : children)
-            if (Status status = read_body(child.node, child.world_from_parent, child.child_class, false); !status)
+            if (Status status = read_body({child.node}, child.world_from_parent, child.child_class, false); !status)
                 return status;
         return Ok{};
     }
@@ -354,9 +368,14 @@ private:
         }
 
         // Stage 2: size (half sizes; trailing unused values are allowed).
+        // MuJoCo overwrites only the components a level gives, so size="0.08" in a class keeps its parent's
+        // half-length: overlay the levels from the root class down to the geom.
         std::array<double, 3> size{0.0, 0.0, 0.0};
-        if (const FoundAttribute found = find_attribute(geom, chain, "size"); found.value != nullptr) {
-            Result<std::vector<double>> values = numbers(found, "size", 1, 3);
+        const std::vector<pugi::xml_node> size_levels = levels_of(geom, chain);
+        for (auto level = size_levels.rbegin(); level != size_levels.rend(); ++level) {
+            const pugi::xml_attribute attribute = level->attribute("size");
+            if (!attribute) continue;
+            Result<std::vector<double>> values = numbers({attribute.value(), *level}, "size", 1, 3);
             if (!values) return values.error();
             for (std::size_t i = 0; i < values->size(); ++i) size[i] = (*values)[i];
         }
@@ -374,8 +393,14 @@ private:
             if (!rotation) return error_at(fromto.element, "fromto end points coincide");
             local.rotation = *rotation;
             local.translation = 0.5 * (from + to);
-            // The half-length slot is size[1] for capsules and cylinders, size[2] for boxes and ellipsoids.
-            size[type == "capsule" || type == "cylinder" ? 1 : 2] = 0.5 * (to - from).norm();
+            // The half-length slot is size[1] for capsules and cylinders, size[2] for boxes and ellipsoids; MuJoCo
+            // (checked with 2.2.2) then gives boxes and ellipsoids a square/round cross-section of size[0].
+            if (type == "capsule" || type == "cylinder") {
+                size[1] = 0.5 * (to - from).norm();
+            } else {
+                size[1] = size[0];
+                size[2] = 0.5 * (to - from).norm();
+            }
         } else {
             if (const FoundAttribute pos = find_attribute(geom, chain, "pos"); pos.value != nullptr) {
                 Result<std::vector<double>> p = numbers(pos, "pos", 3);

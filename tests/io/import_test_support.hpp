@@ -25,12 +25,21 @@ inline std::string compare_volumes(const BoundingVolume& a, const BoundingVolume
         if (far(s->center, t.center) || std::abs(s->radius - t.radius) > tolerance) return "sphere differs";
     } else if (const auto* c = std::get_if<Capsule>(&a)) {
         const auto& d = std::get<Capsule>(b);
-        if (far(c->p0, d.p0) || far(c->p1, d.p1) || std::abs(c->radius - d.radius) > tolerance) return "capsule differs";
+        // A capsule is symmetric: its two end points may come in either order.
+        const bool same_ends = (!far(c->p0, d.p0) && !far(c->p1, d.p1)) || (!far(c->p0, d.p1) && !far(c->p1, d.p0));
+        if (!same_ends || std::abs(c->radius - d.radius) > tolerance) return "capsule differs";
     } else if (const auto* o = std::get_if<Obb>(&a)) {
         const auto& p = std::get<Obb>(b);
         if (far(o->center, p.center)) return "obb centre differs";
-        if (far(o->rotation, p.rotation)) return "obb rotation differs";
-        if (far(o->half_extents, p.half_extents)) return "obb half extents differ";
+        // The same box can be written with its axes permuted or negated when half extents are equal (a fromto
+        // box has a square cross-section), so match every axis of one to a parallel axis of equal extent.
+        for (int i = 0; i < 3; ++i) {
+            bool matched = false;
+            for (int j = 0; j < 3 && !matched; ++j)
+                matched = std::abs(o->half_extents[i] - p.half_extents[j]) <= tolerance &&
+                          (!far(o->rotation.col(i), p.rotation.col(j)) || !far(o->rotation.col(i), -p.rotation.col(j)));
+            if (!matched) return "obb axes or half extents differ";
+        }
     } else {
         const auto& e = std::get<Aabb>(a);
         const auto& f = std::get<Aabb>(b);
