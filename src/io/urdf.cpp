@@ -135,6 +135,20 @@ private:
             pugi::xml_node patched_collision = patched_link.child("collision");
             for (const pugi::xml_node& collision : link.children("collision")) {
                 CollisionSite site{collision, std::nullopt};
+                const pugi::xml_node shape_element = collision.child("geometry").first_child();
+                const std::string_view shape_name = shape_element ? shape_element.name() : "";
+                if (shape_name != "box" && shape_name != "sphere" && shape_name != "cylinder" && shape_name != "mesh" &&
+                    shape_name != "capsule") {
+                    // urdfdom 3 drops such a collision silently; say so, and keep our list in step with its list.
+                    result_.warnings.push_back(source_->warning_at(
+                        collision, shape_name.empty() ? "collision without geometry skipped"
+                                                      : "collision with unknown geometry <" + std::string(shape_name) +
+                                                            "> skipped"));
+                    const pugi::xml_node next = patched_collision.next_sibling("collision");
+                    patched_link.remove_child(patched_collision);
+                    patched_collision = next;
+                    continue;
+                }
                 if (const pugi::xml_node capsule = collision.child("geometry").child("capsule")) {
                     CapsuleShape shape;
                     for (auto [attribute, slot] : {std::pair{"radius", &shape.radius}, {"length", &shape.length}}) {

@@ -96,9 +96,6 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
         {"<robot name=\"r\">\n<link name=\"a\"><collision><geometry>\n<capsule radius=\"x\" length=\"1\"/>"
          "</geometry></collision></link>\n</robot>",
          3, "capsule radius"},
-        {"<robot name=\"r\">\n<link name=\"a\"><collision><geometry>\n<cone radius=\"1\"/>"
-         "</geometry></collision></link>\n</robot>",
-         2, "urdfdom rejected"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path file = folder / ("case" + std::to_string(i) + ".urdf");
@@ -109,6 +106,17 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
         EXPECT_EQ(imported.error().line, cases[i].line) << imported.error().to_string();
         EXPECT_NE(imported.error().message.find(cases[i].problem), std::string::npos) << imported.error().to_string();
     }
+    // An unknown shape is skipped with a warning rather than failing the whole robot.
+    const fs::path cone = folder / "cone.urdf";
+    std::ofstream(cone) << "<robot name=\"r\">\n<link name=\"a\">\n<collision><geometry><cone radius=\"1\"/>"
+                           "</geometry></collision>\n<collision><geometry><sphere radius=\"1\"/></geometry>"
+                           "</collision></link>\n</robot>";
+    const Result<ImportResult> imported = import_urdf(cone.string());
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    EXPECT_EQ(imported->primitives.size(), 1u);
+    ASSERT_EQ(imported->warnings.size(), 1u);
+    EXPECT_NE(imported->warnings[0].find("cone.urdf:3: collision with unknown geometry <cone>"), std::string::npos)
+        << imported->warnings[0];
     fs::remove_all(folder);
 }
 
