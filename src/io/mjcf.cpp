@@ -22,6 +22,8 @@ namespace {
 using detail::XmlSource;
 
 constexpr int max_include_depth = 32;
+// Deeper body or default trees than this are not real models; refusing them keeps the recursion off the stack limit.
+constexpr int max_tree_depth = 1000;
 
 // An attribute value found on an element or in a default class, with the element it came from (for errors).
 struct FoundAttribute {
@@ -144,8 +146,9 @@ private:
     }
 
     // Registers a <default> element and its nested classes. The top-level one is class "main".
-    Status read_default(const pugi::xml_node& element, const std::string& parent) {
+    Status read_default(const pugi::xml_node& element, const std::string& parent, int depth = 0) {
         const bool top_level = parent.empty();
+        if (depth > max_tree_depth) return error_at(element, "<default> classes nested too deeply");
         std::string name = element.attribute("class").as_string(top_level ? "main" : "");
         if (name.empty()) return error_at(element, "nested <default> without a class attribute");
         if (classes_.contains(name) && !top_level)
@@ -153,7 +156,7 @@ private:
         classes_[name].parent = parent;
         return for_each_child(element, [&](pugi::xml_node child) -> Status {
             const std::string_view child_name = child.name();
-            if (child_name == "default") return read_default(child, name);
+            if (child_name == "default") return read_default(child, name, depth + 1);
             if (child_name == "geom") classes_[name].geoms.push_back(child);
             return Ok{};
         });
@@ -276,8 +279,9 @@ private:
     // MuJoCo's geom order (bodies in depth-first order, geoms in document order within a body).
     // `parts` is one <body>, or every <worldbody> of the model for the world body.
     Status read_body(const std::vector<pugi::xml_node>& parts, const RigidTransform& world_from_parent,
-                     std::string child_class, bool is_world) {
+                     std::string child_class, bool is_world, int depth = 0) {
         const pugi::xml_node body = parts.front();
+        if (depth > max_tree_depth) return error_at(body, "bodies nested too deeply");
         RigidTransform world_from_body = world_from_parent;
         std::string body_name = "world";
         const int body_id = body_count_++;
@@ -296,6 +300,7 @@ private:
         };
         std::vector<PendingBody> children;
         int geom_index = 0;
+        int frame_depth = 0;
         // Walks body content; <frame> only adds a transform (and possibly a childclass) for what it contains.
         std::function<Status(const pugi::xml_node&, const RigidTransform&, const std::string&)> walk =
             [&](const pugi::xml_node& container, const RigidTransform& world_from_container,
@@ -314,7 +319,10 @@ private:
                     Result<RigidTransform> local = own_frame(child);
                     if (!local) return local.error();
                     const std::string frame_class = child.attribute("childclass").as_string(container_class.c_str());
-                    return walk(child, world_from_container * *local, frame_class);
+                    if (++frame_depth > max_tree_depth) return error_at(child, "frames nested too deeply");
+                    Status status = walk(child, world_from_container * *local, frame_class);
+                    --frame_depth;
+                    return status;
                 }
                 if (name == "composite" || name == "flexcomp" || name == "replicate" || name == "attach") {
                     warn(child, "<" + std::string(name) + "> skipped: generated geometry is not supported");
@@ -325,7 +333,8 @@ private:
         for (const pugi::xml_node& part : parts)
             if (Status status = walk(part, world_from_body, child_class); !status) return status;
         for (const PendingBody& child : children)
-            if (Status status = read_body({child.node}, child.world_from_parent, child.child_class, false); !status)
+            if (Status status = read_body({child.node}, child.world_from_parent, child.child_class, false, depth + 1);
+                !status)
                 return status;
         return Ok{};
     }

@@ -218,6 +218,19 @@ INSTANTIATE_TEST_SUITE_P(Files, MjcfOracle, ::testing::ValuesIn(oracle_candidate
                              return name + "_" + std::to_string(param_info.index);
                          });
 
+// MuJoCo 2.2.2 refuses these two as they are (attributes from MuJoCo 3); our importer must not.
+TEST(Mjcf, ImportsFilesThatMuJoCo222Refuses) {
+    const fs::path folder = test::shared_models_dir();
+    if (!fs::exists(folder)) GTEST_SKIP() << "no shared models at " << folder;
+    for (const char* name : {"dmc_duplo2x4.xml", "mujoco_cards.xml"}) {
+        std::string why;
+        EXPECT_FALSE(load_with_mujoco(folder / name, why).has_value()) << name;
+        const Result<ImportResult> imported = import_mjcf((folder / name).string());
+        ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+        EXPECT_GT(imported->primitives.size(), 0u) << name;
+    }
+}
+
 TEST(Mjcf, SharedModelsHaveTheDocumentedCounts) {
     const fs::path folder = test::shared_models_dir();
     if (!fs::exists(folder)) GTEST_SKIP() << "no shared models at " << folder;
@@ -371,6 +384,18 @@ TEST(Mjcf, ErrorsNameFileLineAndProblem) {
     const Result<ImportResult> missing = import_mjcf((folder.path / "none.xml").string());
     ASSERT_FALSE(missing.has_value());
     EXPECT_NE(missing.error().message.find("cannot open"), std::string::npos);
+}
+
+TEST(Mjcf, AbsurdNestingIsAnErrorNotACrash) {
+    TempDir folder;
+    std::string text = "<mujoco><worldbody>";
+    for (int i = 0; i < 5000; ++i) text += "<body>";
+    for (int i = 0; i < 5000; ++i) text += "</body>";
+    text += "</worldbody><default>";
+    std::ofstream(folder.path / "deep.xml") << text << "</default></mujoco>";
+    const Result<ImportResult> imported = import_mjcf((folder.path / "deep.xml").string());
+    ASSERT_FALSE(imported.has_value());
+    EXPECT_NE(imported.error().message.find("nested"), std::string::npos) << imported.error().to_string();
 }
 
 TEST(Mjcf, IncludeCycleIsAnError) {
