@@ -2,6 +2,7 @@
 // Mesh import: assimp reads the file, the fitters turn each collision mesh's world-space vertices into a BV.
 #include "hbvh/io/mesh_import.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <regex>
 

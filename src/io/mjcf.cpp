@@ -69,6 +69,10 @@ public:
             });
             !status)
             return status.error();
+        if (world_parts.empty()) {
+            result_.warnings.push_back(source.warning_at(root, "no <worldbody>: the model has no geometry"));
+            return std::move(result_);
+        }
         if (Status status = read_body(world_parts, RigidTransform::identity(), "", true); !status) return status.error();
         return std::move(result_);
     }

@@ -398,6 +398,15 @@ TEST(Mjcf, AbsurdNestingIsAnErrorNotACrash) {
     EXPECT_NE(imported.error().message.find("nested"), std::string::npos) << imported.error().to_string();
 }
 
+TEST(Mjcf, ModelWithoutWorldbodyIsEmptyWithAWarning) {
+    TempDir folder;
+    std::ofstream(folder.path / "empty.xml") << "<mujoco><option timestep=\"0.01\"/></mujoco>";
+    const Result<ImportResult> imported = import_mjcf((folder.path / "empty.xml").string());
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    EXPECT_TRUE(imported->primitives.empty());
+    ASSERT_EQ(imported->warnings.size(), 1u);
+}
+
 TEST(Mjcf, IncludeCycleIsAnError) {
     TempDir folder;
     std::ofstream(folder.path / "a.xml") << "<mujoco><include file=\"b.xml\"/></mujoco>";
