@@ -9,6 +9,7 @@
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/mjcf.hpp"
 #include "hbvh/io/urdf.hpp"
+#include "hbvh/io/xml.hpp"
 #include "xml_source.hpp"
 
 namespace hbvh {
@@ -49,10 +50,16 @@ Result<ImportResult> import_primitives(const std::string& path, ImportFormat for
         case ImportFormat::mjcf: return import_mjcf(path);
         case ImportFormat::urdf: return import_urdf(path);
         case ImportFormat::mesh: return import_mesh(path);
-        case ImportFormat::survey_xml:
-            // TODO(lead): the survey-format reader (include/hbvh/io/xml.hpp) lives on branch `io`, not yet merged
-            // into main. Once merged, read it here and wrap its primitives in an ImportResult with no warnings.
-            return Error("survey-format XML import is not available in this build yet", path);
+        case ImportFormat::survey_xml: {
+            Result<XmlModel> model = read_xml_file(path);
+            if (!model) return model.error();
+            ImportResult result{std::move(model->primitives), {}};
+            // Importing means "primitives in": a stored hierarchy is not an input to the builders.
+            if (model->hierarchy)
+                result.warnings.push_back(
+                    Error("the file's hierarchy is ignored; its leaf volumes are imported as primitives", path).to_string());
+            return result;
+        }
         case ImportFormat::automatic: break;
     }
     return Error("no importer for the requested format", path);

@@ -23,7 +23,7 @@ enum class ImportFormat {
     mjcf,       ///< MuJoCo XML (root <mujoco>).
     urdf,       ///< ROS URDF (root <robot>).
     mesh,       ///< Anything assimp reads: glTF, OBJ, FBX, DAE, STL, PLY, ...
-    survey_xml  ///< hbvh's own primitive XML (io/xml.hpp).
+    survey_xml  ///< hbvh's own primitive XML (io/xml.hpp); a stored hierarchy is dropped with a warning.
 };
 
 /// Reads primitives from `path` in `format`. With ImportFormat::automatic: .urdf -> URDF; .xml -> MJCF when the
