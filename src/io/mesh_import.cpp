@@ -1,0 +1,125 @@
+// SPDX-License-Identifier: MIT
+// Mesh import: assimp reads the file, the fitters turn each collision mesh's world-space vertices into a BV.
+#include "hbvh/io/mesh_import.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+
+#include <assimp/Importer.hpp>
+#include <assimp/postprocess.h>
+#include <assimp/scene.h>
+
+#include "hbvh/fit/fit.hpp"
+
+namespace hbvh {
+namespace {
+
+// The collision kinds of the naming convention, by prefix.
+enum class CollisionKind { none, box, sphere, capsule, convex };
+
+CollisionKind kind_of(std::string_view name) {
+    if (name.starts_with("UBX_")) return CollisionKind::box;
+    if (name.starts_with("USP_")) return CollisionKind::sphere;
+    if (name.starts_with("UCP_")) return CollisionKind::capsule;
+    if (name.starts_with("UCX_")) return CollisionKind::convex;
+    return CollisionKind::none;
+}
+
+// One mesh instance in the scene: its vertices in world space and the name that decides its role.
+struct MeshInstance {
+    std::string name;
+    CollisionKind kind = CollisionKind::none;
+    std::vector<Sphere> points;  // Vertices as radius-0 spheres, the fitters' input.
+};
+
+// assimp reports parse errors as text; some of them carry "line N".
+int line_in(const std::string& message) {
+    static const std::regex line_pattern(R"(line[ :]+(\d+))", std::regex::icase);
+    std::smatch match;
+    if (std::regex_search(message, match, line_pattern)) return std::stoi(match[1].str());
+    return 0;
+}
+
+Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent_transform,
+                         const std::string& path, std::vector<MeshInstance>& out) {
+    const aiMatrix4x4 transform = parent_transform * node.mTransformation;
+    for (unsigned i = 0; i < node.mNumMeshes; ++i) {
+        const aiMesh& mesh = *scene.mMeshes[node.mMeshes[i]];
+        // The node carries the artist's object name in most exporters; fall back to the mesh name.
+        std::string name = node.mName.length > 0 ? node.mName.C_Str() : mesh.mName.C_Str();
+        CollisionKind kind = kind_of(name);
+        if (kind == CollisionKind::none && kind_of(mesh.mName.C_Str()) != CollisionKind::none) {
+            name = mesh.mName.C_Str();
+            kind = kind_of(name);
+        }
+        if (node.mNumMeshes > 1) name += "_" + std::to_string(i);
+        MeshInstance instance{name, kind, {}};
+        instance.points.reserve(mesh.mNumVertices);
+        for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
+            const aiVector3D world = transform * mesh.mVertices[v];
+            const Vec3 point(world.x, world.y, world.z);
+            if (!point.allFinite()) return Error("mesh '" + name + "' has a vertex that is not finite", path);
+            instance.points.push_back({point, 0.0});
+        }
+        out.push_back(std::move(instance));
+    }
+    for (unsigned c = 0; c < node.mNumChildren; ++c)
+        if (Status status = collect_instances(scene, *node.mChildren[c], transform, path, out); !status) return status;
+    return Ok{};
+}
+
+}  // namespace
+
+Result<ImportResult> import_mesh(const std::string& path, const MeshImportOptions& options) {
+    // Only positions are needed: no normals, no triangulation. Assimp has no logger unless one is created, so it
+    // stays silent.
+    Assimp::Importer importer;
+    const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
+    if (scene == nullptr || scene->mRootNode == nullptr) {
+        const std::string reason = importer.GetErrorString();
+        return Error("cannot read mesh: " + (reason.empty() ? std::string("unknown assimp error") : reason), path,
+                     line_in(reason));
+    }
+    std::vector<MeshInstance> instances;
+    if (Status status = collect_instances(*scene, *scene->mRootNode, aiMatrix4x4(), path, instances); !status)
+        return status.error();
+    if (instances.empty()) return Error("the file holds no meshes", path);
+
+    ImportResult result;
+    const bool has_collision_meshes = std::any_of(instances.begin(), instances.end(), [](const MeshInstance& m) {
+        return m.kind != CollisionKind::none;
+    });
+    if (!has_collision_meshes && !options.one_primitive_per_mesh)
+        return Error("no collision meshes (names starting UBX_, USP_, UCP_ or UCX_); set one_primitive_per_mesh to "
+                     "fit the render meshes",
+                     path);
+    std::size_t ignored = 0;
+    for (const MeshInstance& instance : instances) {
+        if (has_collision_meshes && instance.kind == CollisionKind::none) {
+            ++ignored;
+            continue;
+        }
+        if (instance.points.empty()) {
+            result.warnings.push_back(Error("mesh '" + instance.name + "' has no vertices; skipped", path).to_string());
+            continue;
+        }
+        BoundingVolume volume;
+        switch (instance.kind) {
+            case CollisionKind::box: volume = fit_obb(instance.points); break;
+            case CollisionKind::sphere: volume = fit_sphere(instance.points); break;
+            case CollisionKind::capsule: volume = fit_capsule(instance.points); break;
+            case CollisionKind::convex:
+            case CollisionKind::none: volume = fit_best(instance.points, options.policy); break;
+        }
+        result.primitives.push_back({std::move(volume), instance.name});
+    }
+    if (ignored > 0)
+        result.warnings.push_back(Error(std::to_string(ignored) +
+                                            " render mesh(es) ignored: the file has UBX_/USP_/UCP_/UCX_ collision meshes",
+                                        path)
+                                      .to_string());
+    return result;
+}
+
+}  // namespace hbvh
