@@ -3,7 +3,7 @@
 #include "hbvh/io/bv_mesh.hpp"
 
 #include <cmath>
-#include <limits>
+#include <utility>
 #include <numbers>
 
 #include "hbvh/assert.hpp"
@@ -51,36 +51,100 @@ TriangleMesh box_mesh(const Mat3& axes, CornerFn corner) {
     return mesh;
 }
 
-/// A sphere (p0 == p1) or capsule around the segment p0-p1 with radius r. The unit sphere is cut into
-/// `rings` latitude bands measured from +w; the northern half is centred on p1, the southern on p0.
+/// cos and sin that are exact at the quarter turns. Those angles give the world-axis extremes of
+/// spheres, and rounding there would make the mesh's box differ from world_aabb.
+std::pair<double, double> exact_cos_sin(double angle) {
+    const double quarter_turns = angle / (0.5 * std::numbers::pi);
+    const double nearest = std::round(quarter_turns);
+    if (std::abs(quarter_turns - nearest) < 1e-12) {
+        static constexpr std::array<std::pair<double, double>, 4> axes{{{1, 0}, {0, 1}, {-1, 0}, {0, -1}}};
+        return axes[static_cast<std::size_t>((static_cast<long long>(nearest) % 4 + 4) % 4)];
+    }
+    return {std::cos(angle), std::sin(angle)};
+}
+
+/// Adds `value` to the sorted grid coordinates `values`, dropping the uniform coordinates within `merge`
+/// of it (on a circle of circumference `period`, or on a line when period is 0) so no sliver bands appear.
+void require_coordinate(std::vector<double>& values, std::vector<bool>& required, double value, double period,
+                        double merge) {
+    for (std::size_t i = 0; i < values.size();) {
+        double gap = std::abs(values[i] - value);
+        if (period > 0.0) gap = std::min(gap, period - gap);
+        // Within a nanoradian the existing line serves: the touching point then moves by ~1e-18 r along
+        // its axis (it is an extreme, so the error is second order), and no near-duplicate row appears.
+        if (gap < 1e-9) {
+            required[i] = true;
+            return;
+        }
+        if (gap < merge && !required[i]) {
+            values.erase(values.begin() + static_cast<std::ptrdiff_t>(i));
+            required.erase(required.begin() + static_cast<std::ptrdiff_t>(i));
+        } else {
+            ++i;
+        }
+    }
+    const auto at = std::lower_bound(values.begin(), values.end(), value);
+    required.insert(required.begin() + (at - values.begin()), true);
+    values.insert(at, value);
+}
+
+/// A latitude-longitude grid on the unit sphere: polar angles strictly between the poles (always
+/// including the equator) and azimuths in [0, 2 pi), both ascending.
+struct SphereGrid {
+    std::vector<double> thetas;
+    std::vector<double> phis;
+    std::vector<bool> theta_required;
+    std::vector<bool> phi_required;
+
+    explicit SphereGrid(const MeshDetail& detail) {
+        const std::uint32_t segments = std::max<std::uint32_t>(4, (detail.segments + 3) / 4 * 4);
+        const std::uint32_t rings = std::max<std::uint32_t>(2, (detail.rings + 1) / 2 * 2);
+        for (std::uint32_t ring = 1; ring < rings; ++ring) thetas.push_back(std::numbers::pi * ring / rings);
+        for (std::uint32_t s = 0; s < segments; ++s) phis.push_back(2.0 * std::numbers::pi * s / segments);
+        theta_required.assign(thetas.size(), false);
+        phi_required.assign(phis.size(), false);
+        theta_required[rings / 2 - 1] = true;  // the equator, where a capsule's cylinder attaches
+    }
+
+    /// Makes the unit direction `d` (in the frame u, v, w) a grid vertex, unless it is a pole.
+    void require_direction(const Vec3& d) {
+        const double theta = std::acos(std::clamp(d.z(), -1.0, 1.0));
+        if (theta <= 0.0 || theta >= std::numbers::pi) return;
+        double phi = std::atan2(d.y(), d.x());
+        if (phi < 0.0) phi += 2.0 * std::numbers::pi;
+        const double theta_merge = 0.25 * std::numbers::pi / static_cast<double>(thetas.size() + 1);
+        const double phi_merge = 0.25 * 2.0 * std::numbers::pi / static_cast<double>(phis.size());
+        require_coordinate(thetas, theta_required, theta, 0.0, theta_merge);
+        require_coordinate(phis, phi_required, phi, 2.0 * std::numbers::pi, phi_merge);
+    }
+};
+
+/// A sphere (p0 == p1) or capsule around the segment p0-p1 with radius r, on `grid` in the right-handed
+/// frame (u, v, w) = columns of `frame`. Rows with theta <= pi/2 are centred on p1, the others on p0;
+/// a capsule repeats the equator row on both ends, and the band between the copies is the cylinder.
 TriangleMesh swept_sphere_mesh(const Vec3& p0, const Vec3& p1, double radius, const Mat3& frame,
-                               const MeshDetail& detail) {
-    const std::uint32_t segments = std::max<std::uint32_t>(4, (detail.segments + 3) / 4 * 4);
-    const std::uint32_t rings = std::max<std::uint32_t>(2, (detail.rings + 1) / 2 * 2);
+                               const SphereGrid& grid) {
     const bool has_cylinder = p0 != p1;
     const Vec3 u = frame.col(0), v = frame.col(1), w = frame.col(2);
+    const auto segments = static_cast<std::uint32_t>(grid.phis.size());
     TriangleMesh mesh;
     const auto add_vertex = [&](const Vec3& centre, const Vec3& direction) {
         mesh.positions.push_back(centre + radius * direction);
         mesh.normals.push_back(direction);
     };
 
-    // Stage 1: vertices. North pole, the rings (the equator twice for a capsule), south pole.
+    // Stage 1: vertices. North pole, the rows (the equator twice for a capsule), south pole.
     add_vertex(p1, w);
     std::uint32_t row_count = 0;
-    for (std::uint32_t ring = 1; ring < rings; ++ring) {
-        const double theta = std::numbers::pi * ring / rings;
-        const bool north = 2 * ring <= rings;
-        const int copies = (2 * ring == rings && has_cylinder) ? 2 : 1;
+    for (double theta : grid.thetas) {
+        const auto [cos_theta, sin_theta] = exact_cos_sin(theta);
+        const bool equator = cos_theta == 0.0;
+        const int copies = (equator && has_cylinder) ? 2 : 1;
         for (int copy = 0; copy < copies; ++copy) {
-            const Vec3& centre = (north && copy == 0) ? p1 : p0;
-            for (std::uint32_t s = 0; s < segments; ++s) {
-                const double phi = 2.0 * std::numbers::pi * s / segments;
-                // Exact zeros at the quarter turns keep the world-axis extremes exact for spheres.
-                const double cos_phi = (4 * s == segments || 4 * s == 3 * segments) ? 0.0 : std::cos(phi);
-                const double sin_phi = (2 * s == segments || s == 0) ? 0.0 : std::sin(phi);
-                const double cos_theta = 2 * ring == rings ? 0.0 : std::cos(theta);
-                add_vertex(centre, std::sin(theta) * (cos_phi * u + sin_phi * v) + cos_theta * w);
+            const Vec3& centre = (cos_theta >= 0.0 && copy == 0) ? p1 : p0;
+            for (double phi : grid.phis) {
+                const auto [cos_phi, sin_phi] = exact_cos_sin(phi);
+                add_vertex(centre, sin_theta * (cos_phi * u + sin_phi * v) + cos_theta * w);
             }
             ++row_count;
         }
@@ -98,30 +162,6 @@ TriangleMesh swept_sphere_mesh(const Vec3& p0, const Vec3& p1, double radius, co
         mesh.indices.insert(mesh.indices.end(), {at(row_count - 1, s), south, at(row_count - 1, s + 1)});
     }
     return mesh;
-}
-
-/// Moves the vertex nearest to each of the capsule's six world-axis support points onto that point.
-/// A tilted capsule's UV rings miss those points, and without them the mesh's box would be smaller than
-/// world_aabb. The support points lie on the surface, so every vertex stays on it.
-void snap_to_support_points(TriangleMesh& mesh, const Capsule& capsule) {
-    for (int axis = 0; axis < 3; ++axis) {
-        for (double sign : {-1.0, 1.0}) {
-            const Vec3 direction = sign * Vec3::Unit(axis);
-            const Vec3& end = direction.dot(capsule.p1) >= direction.dot(capsule.p0) ? capsule.p1 : capsule.p0;
-            const Vec3 support = end + capsule.radius * direction;
-            std::size_t nearest = 0;
-            double best = std::numeric_limits<double>::infinity();
-            for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
-                const double d = (mesh.positions[i] - support).squaredNorm();
-                if (d < best) {
-                    best = d;
-                    nearest = i;
-                }
-            }
-            mesh.positions[nearest] = support;
-            mesh.normals[nearest] = direction;
-        }
-    }
 }
 
 template <class... Ts>
@@ -144,7 +184,9 @@ TriangleMesh triangulate(const BoundingVolume& bv, const MeshDetail& detail) {
             },
             [](const Obb& box) { return box_mesh(box.rotation, [&](int bits) { return box.corner(bits); }); },
             [&](const Sphere& sphere) {
-                return swept_sphere_mesh(sphere.center, sphere.center, sphere.radius, Mat3::Identity(), detail);
+                // World-aligned frame: the uniform grid already holds the six extremes.
+                return swept_sphere_mesh(sphere.center, sphere.center, sphere.radius, Mat3::Identity(),
+                                         SphereGrid(detail));
             },
             [&](const Capsule& capsule) {
                 // A right-handed frame (u, v, w) with w along the axis; u from the world axis least
@@ -155,9 +197,13 @@ TriangleMesh triangulate(const BoundingVolume& bv, const MeshDetail& detail) {
                 const Vec3 u = Vec3::Unit(least).cross(w).normalized();
                 Mat3 frame;
                 frame << u, w.cross(u), w;
-                TriangleMesh mesh = swept_sphere_mesh(capsule.p0, capsule.p1, capsule.radius, frame, detail);
-                snap_to_support_points(mesh, capsule);
-                return mesh;
+                // A tilted capsule touches its world AABB at points between the uniform grid lines; add
+                // grid lines through them, so the mesh's box is world_aabb and no vertex leaves the surface.
+                // The touching point in direction e is end + r e, on the hemisphere facing e.
+                SphereGrid grid(detail);
+                for (int axis = 0; axis < 3; ++axis)
+                    for (double sign : {-1.0, 1.0}) grid.require_direction(frame.transpose() * (sign * Vec3::Unit(axis)));
+                return swept_sphere_mesh(capsule.p0, capsule.p1, capsule.radius, frame, grid);
             },
         },
         bv);
