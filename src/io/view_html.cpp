@@ -60,7 +60,7 @@ constexpr std::string_view page_middle = R"HTML(</title>
   <div><span id="swatch"></span><b id="level-name"></b></div>
   <input id="level" type="range" min="0" max="0" step="1" value="0" aria-label="level">
   <table id="stats"></table>
-  <div id="hint">drag: rotate &middot; wheel: zoom &middot; &larr;/&rarr;: level &middot; #level=N in the URL</div>
+  <div id="hint">drag: rotate &middot; wheel: zoom &middot; &larr;/&rarr;: level &middot; URL #level=N, or #all for every level</div>
 </div>
 <script type="application/json" id="hbvh-data">)HTML";
 
@@ -92,7 +92,7 @@ constexpr std::string_view page_tail = R"HTML(</script>
   const centre = [0, 1, 2].map(function (k) { return 0.5 * (data.bounds[0][k] + data.bounds[1][k]); });
   const radius = Math.max(1e-12, 0.5 * Math.hypot(data.bounds[1][0] - data.bounds[0][0],
       data.bounds[1][1] - data.bounds[0][1], data.bounds[1][2] - data.bounds[0][2]));
-  const view = { level: 0, yaw: -0.6, pitch: 0.45, zoom: 1 };
+  const view = { level: 0, yaw: -0.6, pitch: 0.45, zoom: 1, all: false };
 
   function rgba(rgb, alpha, scale) {
     return "rgba(" + Math.round(255 * Math.min(1, rgb[0] * scale)) + "," + Math.round(255 * Math.min(1, rgb[1] * scale)) +
@@ -120,23 +120,16 @@ constexpr std::string_view page_tail = R"HTML(</script>
     return list;
   }
 
-  function render() {
-    const ratio = window.devicePixelRatio || 1;
-    const width = Math.max(1, Math.floor(canvas.clientWidth * ratio));
-    const height = Math.max(1, Math.floor(canvas.clientHeight * ratio));
-    if (canvas.width !== width || canvas.height !== height) { canvas.width = width; canvas.height = height; }
-    context.setTransform(1, 0, 0, 1, 0, 0);
-    context.fillStyle = "#fafafa";
-    context.fillRect(0, 0, width, height);
-
+  // Draws level `depth` into the canvas rectangle (x0, y0, width, height).
+  function drawScene(depth, x0, y0, width, height, ratio) {
     // Camera: rotate the model about its centre (yaw about +y, then pitch about +x), then a perspective
-    // projection from distance 3 radii, scaled so the bounding sphere fills most of the canvas.
+    // projection from distance 3 radii, scaled so the bounding sphere fills most of the rectangle.
     const cy = Math.cos(view.yaw), sy = Math.sin(view.yaw), cp = Math.cos(view.pitch), sp = Math.sin(view.pitch);
     const distance = 3 * radius;
     const focal = 0.46 * Math.min(width, height) * (distance - radius) / radius * view.zoom;
     const light = [0.35, 0.55, 0.76];
     const polygons = [];
-    (levelCount > 0 ? drawList(view.level) : []).forEach(function (item) {
+    drawList(depth).forEach(function (item) {
       const volume = volumes[item.bv];
       const count = volume.points.length / 3;
       const camera = new Float64Array(3 * count), screen = new Float64Array(2 * count);
@@ -146,8 +139,8 @@ constexpr std::string_view page_tail = R"HTML(</script>
         const y2 = cp * y - sp * z1, z2 = sp * y + cp * z1;
         camera[3 * v] = x1; camera[3 * v + 1] = y2; camera[3 * v + 2] = z2;
         const w = distance - z2;
-        screen[2 * v] = 0.5 * width + focal * x1 / w;
-        screen[2 * v + 1] = 0.5 * height - focal * y2 / w;
+        screen[2 * v] = x0 + 0.5 * width + focal * x1 / w;
+        screen[2 * v + 1] = y0 + 0.5 * height - focal * y2 / w;
       }
       volume.polygons.forEach(function (polygon) {
         const a = polygon[0], b = polygon[1], c = polygon[2];
@@ -157,9 +150,9 @@ constexpr std::string_view page_tail = R"HTML(</script>
         const length = Math.hypot(nx, ny, nz);
         // Two-sided Lambert: translucent volumes show their inside too.
         const shade = length > 0 ? 0.55 + 0.5 * Math.abs((nx * light[0] + ny * light[1] + nz * light[2]) / length) : 0.8;
-        let depth = 0;
-        polygon.forEach(function (v) { depth += camera[3 * v + 2]; });
-        polygons.push({ item: item, screen: screen, polygon: polygon, shade: shade, depth: depth / polygon.length });
+        let depthSum = 0;
+        polygon.forEach(function (v) { depthSum += camera[3 * v + 2]; });
+        polygons.push({ item: item, screen: screen, polygon: polygon, shade: shade, depth: depthSum / polygon.length });
       });
     });
     // Painter's algorithm: farthest first (smallest camera z, as the camera looks down -z from +z).
@@ -180,6 +173,34 @@ constexpr std::string_view page_tail = R"HTML(</script>
         context.stroke();
       }
     });
+  }
+
+  function render() {
+    const ratio = window.devicePixelRatio || 1;
+    const width = Math.max(1, Math.floor(canvas.clientWidth * ratio));
+    const height = Math.max(1, Math.floor(canvas.clientHeight * ratio));
+    if (canvas.width !== width || canvas.height !== height) { canvas.width = width; canvas.height = height; }
+    context.setTransform(1, 0, 0, 1, 0, 0);
+    context.fillStyle = "#fafafa";
+    context.fillRect(0, 0, width, height);
+    if (levelCount === 0) return;
+    if (!view.all) { drawScene(view.level, 0, 0, width, height, ratio); return; }
+    // All levels side by side, like the survey's Figures 14-15: a grid of tiles, each labelled.
+    const columns = Math.ceil(Math.sqrt(levelCount * width / height));
+    const rows = Math.ceil(levelCount / columns);
+    const tileWidth = width / columns, tileHeight = height / rows;
+    for (let depth = 0; depth < levelCount; ++depth) {
+      const x0 = (depth % columns) * tileWidth, y0 = Math.floor(depth / columns) * tileHeight;
+      context.save();
+      context.beginPath();
+      context.rect(x0, y0, tileWidth, tileHeight);
+      context.clip();
+      drawScene(depth, x0, y0, tileWidth, tileHeight, ratio);
+      context.restore();
+      context.fillStyle = rgba(data.colors[depth], 1, 0.7);
+      context.font = "bold " + Math.round(15 * ratio) + "px system-ui, sans-serif";
+      context.fillText("level " + depth, x0 + 12 * ratio, y0 + tileHeight - 12 * ratio);
+    }
   }
 
   function format(value) {
@@ -218,12 +239,19 @@ constexpr std::string_view page_tail = R"HTML(</script>
     if (levelCount === 0) return;
     view.level = Math.max(0, Math.min(levelCount - 1, level | 0));
     slider.value = String(view.level);
-    if (updateHash) history.replaceState(null, "", "#level=" + view.level);
+    if (updateHash) {
+      view.all = false;
+      document.getElementById("panel").style.display = "";
+      history.replaceState(null, "", "#level=" + view.level);
+    }
     showStats();
     render();
   }
 
   function levelFromHash() {
+    // "#all" shows every level at once (the panel is hidden then): handy for pictures of a whole tree.
+    view.all = /(^#|&)all\b/.test(window.location.hash);
+    document.getElementById("panel").style.display = view.all ? "none" : "";
     const match = /level=(\d+)/.exec(window.location.hash);
     return match ? parseInt(match[1], 10) : 0;
   }
@@ -255,10 +283,12 @@ constexpr std::string_view page_tail = R"HTML(</script>
     view.zoom = Math.max(0.1, Math.min(20, view.zoom * Math.exp(-0.001 * event.deltaY)));
     render();
   }, { passive: false });
-  if (levelCount === 0) { showEmpty(); return; }
+  if (levelCount === 0) {
+    document.getElementById("level-name").textContent = "empty hierarchy";
+    render();
+    return;
+  }
   setLevel(levelFromHash(), false);
-
-  function showEmpty() { document.getElementById("level-name").textContent = "empty hierarchy"; render(); }
 })();
 </script>
 </body>

@@ -20,7 +20,8 @@ struct HtmlOptions {
 /// One HTML page that draws the object and the BVs of one level at a time (a slider picks the level,
 /// drag rotates, the wheel zooms, the arrow keys step through levels). The initial level comes from
 /// the URL hash "#level=N" (default 0; clamped to the deepest level) and the slider keeps the hash up
-/// to date. Each level shows its nodes translucent in level_color(depth), the primitives inside them in
+/// to date; "#all" draws every level at once in a grid of labelled tiles (the survey's Figures 14-15),
+/// without the panel. Each level shows its nodes translucent in level_color(depth), the primitives inside them in
 /// solid grey, and carried leaves in carried_color() (see LevelView), with per-level statistics: nodes
 /// on the level, carried leaves, sum of volumes, the level's share of the Eq. 2 cost, types used.
 ///
