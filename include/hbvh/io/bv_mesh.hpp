@@ -12,10 +12,11 @@ namespace hbvh {
 /// An indexed triangle mesh in world space. Triangles are counter-clockwise seen from outside
 /// (glTF's front-face rule), and normals are the exact outward surface normals at the vertices.
 struct TriangleMesh {
-    std::vector<Vec3> positions;
+    std::vector<Vec3> positions;          ///< World coordinates.
     std::vector<Vec3> normals;            ///< Unit length, one per position.
     std::vector<std::uint32_t> indices;   ///< Three per triangle, into positions.
 
+    /// indices.size() / 3.
     [[nodiscard]] std::size_t triangle_count() const { return indices.size() / 3; }
 };
 

@@ -19,7 +19,7 @@ namespace hbvh {
 /// level is exactly the primitive set. The survey's appendix C draws such carried nodes grey, and so do
 /// hbvh's exporters.
 struct LevelView {
-    std::uint32_t depth = 0;
+    std::uint32_t depth = 0;             ///< 0 for the root's level.
     std::vector<std::uint32_t> nodes;    ///< Indices of the nodes at exactly this depth, ascending.
     std::vector<std::uint32_t> carried;  ///< Leaves of smaller depth shown again here, ascending.
     std::uint32_t inner_count = 0;       ///< How many of `nodes` are inner nodes.
