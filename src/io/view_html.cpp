@@ -306,9 +306,11 @@ std::string export_html(const Bvh& bvh, std::string_view title, const HtmlOption
     const double quantum = size > 0.0 ? size / 1048576.0 : 1.0;  // 2^-20 of the model: far below a pixel
 
     // Stage 2: per node its type, label data and mesh in grid units.
+    const MeshDetail detail =
+        bvh.nodes.size() > options.coarse_above_nodes ? MeshDetail{8, 4} : options.detail;
     json bvs = json::array();
     for (const Node& node : bvh.nodes) {
-        const TriangleMesh mesh = triangulate(node.volume, options.detail);
+        const TriangleMesh mesh = triangulate(node.volume, detail);
         json points = json::array();
         for (const Vec3& p : mesh.positions)
             for (Eigen::Index k = 0; k < 3; ++k) points.push_back(std::llround((p[k] - bounds.min[k]) / quantum));

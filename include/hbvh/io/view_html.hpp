@@ -15,6 +15,9 @@ struct HtmlOptions {
     /// Tessellation of spheres and capsules; coarser than the glTF default because the page draws with
     /// the 2D canvas, where each triangle costs a path fill.
     MeshDetail detail{16, 8};
+    /// Above this many nodes curved surfaces use 8 segments x 4 rings instead, so that large scenes
+    /// still rotate smoothly (a 2D canvas fills some 10^5 triangles per second on a slow machine).
+    std::size_t coarse_above_nodes = 300;
 };
 
 /// One HTML page that draws the object and the BVs of one level at a time (a slider picks the level,
