@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // export_dot(): labels, carried copies, escaping, and that Graphviz accepts the output.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -52,7 +53,8 @@ TEST(ExportDot, EmptyHierarchyIsAnEmptyGraph) { EXPECT_EQ(export_dot(Bvh{}), "di
 
 TEST(ExportDot, GraphvizAcceptsIt) {
     if (std::system("dot -V > /dev/null 2>&1") != 0) GTEST_SKIP() << "graphviz is not installed";
-    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "hbvh_dot";
+    // Per process: other checkouts may run the same test at the same time.
+    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("hbvh_dot_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     Bvh bvh = test::sample_hierarchy();
     bvh.primitives[4].name = "odd \"name\" \\ here";
@@ -64,6 +66,7 @@ TEST(ExportDot, GraphvizAcceptsIt) {
     const std::string svg((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_NE(svg.find("<svg"), std::string::npos);
     EXPECT_NE(svg.find("#4 odd"), std::string::npos);
+    std::filesystem::remove_all(dir);
 }
 
 }  // namespace

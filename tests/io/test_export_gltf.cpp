@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // export_gltf(): structure, embedded buffer contents, and the Khronos validator's verdict.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <bit>
 #include <cstdlib>
@@ -117,7 +118,8 @@ void expect_valid_gltf(const std::string& text, const std::string& name) {
     if (std::system("node --version > /dev/null 2>&1") != 0) GTEST_SKIP() << "node is not installed";
     if (!std::filesystem::exists(tools / "node_modules" / "gltf-validator" / "package.json"))
         GTEST_SKIP() << "gltf-validator is not installed (run `npm ci` in tools/)";
-    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "hbvh_gltf";
+    // Per process: other checkouts may run the same test at the same time.
+    const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / ("hbvh_gltf_" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const std::filesystem::path file = dir / (name + ".gltf");
     const std::filesystem::path log = dir / (name + ".log");
@@ -128,6 +130,7 @@ void expect_valid_gltf(const std::string& text, const std::string& name) {
     std::ifstream in(log);
     const std::string report((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     EXPECT_EQ(status, 0) << report;
+    std::filesystem::remove_all(dir);
 }
 
 TEST(ExportGltf, KhronosValidatorFindsNoErrors) {
