@@ -19,6 +19,8 @@ int main(int argc, char** argv) {
     add_compare_command(app, command);
     add_collide_command(app, command);
     add_simulate_command(app, command);
+    add_export_command(app, command);
+    add_view_command(app, command);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

@@ -12,6 +12,7 @@
 #include <Eigen/SVD>
 #include <pugixml.hpp>
 
+#include "hbvh/assert.hpp"
 #include "hbvh/io/file.hpp"
 
 namespace hbvh {
@@ -514,6 +515,9 @@ std::string write_xml(const Bvh& bvh) {
         auto [index, parent] = stack.back();
         stack.pop_back();
         const Node& node = bvh.nodes[index];
+        // Broken indices are a bug in whoever built the tree, not bad input.
+        HBVH_ASSERT(node.is_leaf() ? node.primitive < bvh.primitives.size()
+                                   : std::size_t{node.first_child} + node.child_count <= bvh.nodes.size());
         pugi::xml_node element = parent.append_child("volume");
         if (node.is_leaf()) {
             const Primitive& primitive = bvh.primitives[node.primitive];

@@ -1,0 +1,137 @@
+// SPDX-License-Identifier: MIT
+// `hbvh export`: pictures of a hierarchy's levels (glTF 2.0) or of its tree (Graphviz DOT, or SVG via dot).
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+
+#include "commands/command.hpp"
+#include "hbvh/io/export_dot.hpp"
+#include "hbvh/io/export_gltf.hpp"
+#include "hbvh/io/file.hpp"
+
+extern char** environ;
+
+namespace hbvh::cli {
+namespace {
+struct ExportArguments {
+    std::string input;
+    std::string input_format;
+    std::string output;
+    std::string format;
+    BuilderFlags builder;
+    bool overlay = false;
+    bool no_carry = false;
+};
+
+/// The export format: --format when given, else the output's extension.
+Result<std::string> export_format(const ExportArguments& args) {
+    std::string format = args.format;
+    if (format.empty()) {
+        format = std::filesystem::path(args.output).extension().string();
+        if (!format.empty()) format.erase(0, 1);
+    }
+    if (format == "gltf" || format == "dot" || format == "svg") return format;
+    if (format.empty()) return Error{"cannot tell the format of '" + args.output + "': use .gltf, .dot or .svg, or --format"};
+    return Error{"unknown export format '" + format + "' (gltf, dot or svg)"};
+}
+
+/// The full path of `program` on PATH, or empty when it is not there.
+std::filesystem::path find_on_path(const std::string& program) {
+    const char* path = std::getenv("PATH");
+    std::string_view rest = path ? path : "";
+    while (!rest.empty()) {
+        const std::size_t colon = rest.find(':');
+        const std::string_view dir = rest.substr(0, colon);
+        rest = colon == std::string_view::npos ? std::string_view{} : rest.substr(colon + 1);
+        const std::filesystem::path candidate = std::filesystem::path(dir.empty() ? "." : std::string(dir)) / program;
+        if (::access(candidate.c_str(), X_OK) == 0 && !std::filesystem::is_directory(candidate)) return candidate;
+    }
+    return {};
+}
+
+/// Renders DOT text to SVG with Graphviz's `dot`, through a private temporary directory (dot reads and
+/// writes files; no shell is involved, so no quoting of user paths can go wrong).
+Result<std::string> render_svg(const std::string& dot_text) {
+    const std::filesystem::path dot = find_on_path("dot");
+    if (dot.empty()) return Error{"Graphviz 'dot' was not found on PATH; install graphviz, or write .dot instead"};
+    std::string pattern = (std::filesystem::temp_directory_path() / "hbvh-export-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr) return Error{"cannot create a temporary directory"};
+    const std::filesystem::path dir = pattern;
+    // Removes the directory however this function ends.
+    const auto cleanup = std::unique_ptr<const std::filesystem::path, void (*)(const std::filesystem::path*)>(
+        &dir, [](const std::filesystem::path* d) {
+            std::error_code ignored;
+            std::filesystem::remove_all(*d, ignored);
+        });
+    const std::string in = (dir / "tree.dot").string();
+    const std::string out = (dir / "tree.svg").string();
+    if (Status written = write_file_atomic(in, dot_text); !written) return written.error();
+
+    std::string program = dot.string();
+    std::string type_flag = "-Tsvg", output_flag = "-o";
+    std::string in_path = in, out_path = out;
+    char* argv[] = {program.data(), type_flag.data(), in_path.data(), output_flag.data(), out_path.data(), nullptr};
+    pid_t child = 0;
+    if (::posix_spawn(&child, program.c_str(), nullptr, nullptr, argv, environ) != 0)
+        return Error{"cannot run " + program};
+    int status = 0;
+    if (::waitpid(child, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+        return Error{"Graphviz 'dot' failed to render the tree (see its message above)"};
+    return read_text_file(out);
+}
+
+int run_export(const ExportArguments& args) {
+    Result<std::string> format = export_format(args);
+    if (!format) {
+        report_error(format.error());
+        return exit_bad_usage;
+    }
+    Result<Model> model = load_model(args.input, args.input_format);
+    if (!model) return report_error(model.error());
+    report_warnings(model->warnings);
+    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    if (!bvh) return report_error(bvh.error());
+
+    std::string content;
+    if (*format == "gltf") {
+        GltfOptions options;
+        options.side_by_side = !args.overlay;
+        content = export_gltf(bvh.value(), options);
+    } else {
+        content = export_dot(bvh.value(), {.carry_leaves = !args.no_carry});
+        if (*format == "svg") {
+            Result<std::string> svg = render_svg(content);
+            if (!svg) return report_error(svg.error());
+            content = std::move(svg.value());
+        }
+    }
+    if (Status written = write_output(args.output, content); !written) return report_error(written.error());
+    return exit_ok;
+}
+}  // namespace
+
+void add_export_command(CLI::App& app, Command& command) {
+    auto args = std::make_shared<ExportArguments>();
+    CLI::App* sub = app.add_subcommand(
+        "export", "Pictures of a hierarchy: its levels as glTF 2.0 meshes, or its tree as Graphviz DOT / SVG");
+    sub->add_option("file", args->input, "Hierarchy file, or a primitive set (built first with -a)")->required();
+    sub->add_option("-o,--output", args->output, "Output .gltf, .dot or .svg, or - for stdout (with --format)")
+        ->required();
+    sub->add_option("--format", args->format, "gltf, dot or svg, when the output's extension does not tell")
+        ->check(CLI::IsMember({"gltf", "dot", "svg"}));
+    sub->add_option("--input-format", args->input_format, "Input format when the extension does not tell");
+    args->builder.add_to(*sub);
+    sub->add_flag("--overlay", args->overlay, "glTF: put all levels at the same place instead of side by side");
+    sub->add_flag("--no-carry", args->no_carry,
+                  "DOT/SVG: draw each leaf under its parent, without grey copies down to the bottom row");
+    sub->footer("Examples: hbvh export data/models/chair.xml -o chair.gltf\n"
+                "          hbvh export chair.hbvh.xml -o chair.svg   (needs Graphviz's dot on PATH)\n"
+                "See docs/export.md.");
+    sub->callback([&command, args] { command = [args] { return run_export(*args); }; });
+}
+
+}  // namespace hbvh::cli
