@@ -17,6 +17,7 @@ int main(int argc, char** argv) {
     add_stats_command(app, command);
     add_generate_command(app, command);
     add_compare_command(app, command);
+    add_convert_command(app, command);
     add_collide_command(app, command);
     add_simulate_command(app, command);
     add_export_command(app, command);

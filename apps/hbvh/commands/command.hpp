@@ -28,6 +28,7 @@ void add_build_command(CLI::App& app, Command& command);
 void add_stats_command(CLI::App& app, Command& command);
 void add_generate_command(CLI::App& app, Command& command);
 void add_compare_command(CLI::App& app, Command& command);
+void add_convert_command(CLI::App& app, Command& command);
 void add_collide_command(CLI::App& app, Command& command);
 void add_simulate_command(CLI::App& app, Command& command);
 void add_export_command(CLI::App& app, Command& command);

@@ -2,28 +2,51 @@
 // Input, output and error reporting shared by all subcommands.
 #include <fmt/core.h>
 
+#include <algorithm>
+#include <filesystem>
 #include <iostream>
 #include <iterator>
 
 #include "commands/command.hpp"
 #include "hbvh/io/file.hpp"
+#include "hbvh/io/import.hpp"
 #include "hbvh/io/xml.hpp"
 
 namespace hbvh::cli {
 
 Result<Model> load_model(const std::string& path, const std::string& format) {
-    std::string text;
-    if (path == "-") {
-        text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-    } else {
-        Result<std::string> file = read_text_file(path);
-        if (!file) return file.error();
-        text = std::move(file.value());
+    // The survey format keeps a stored hierarchy; the importers give primitives only.
+    static const std::pair<const char*, ImportFormat> formats[] = {
+        {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
+        {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
+    const auto chosen = std::find_if(std::begin(formats), std::end(formats),
+                                     [&](const auto& entry) { return format == entry.first; });
+    if (chosen == std::end(formats))
+        return Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf or mesh)", path};
+
+    const std::string extension = std::filesystem::path(path).extension().string();
+    const bool maybe_survey = path == "-" || chosen->second == ImportFormat::survey_xml ||
+                              (chosen->second == ImportFormat::automatic && extension == ".xml");
+    if (maybe_survey) {
+        std::string text;
+        if (path == "-") {
+            text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
+        } else {
+            Result<std::string> file = read_text_file(path);
+            if (!file) return file.error();
+            text = std::move(file.value());
+        }
+        // An .xml whose root is <mujoco> is MJCF: hand it to the importer below.
+        if (path == "-" || chosen->second == ImportFormat::survey_xml || text.find("<mujoco") == std::string::npos) {
+            Result<XmlModel> xml = read_xml_string(text, path == "-" ? "<stdin>" : path);
+            if (!xml) return xml.error();
+            return Model{std::move(xml->primitives), std::move(xml->hierarchy), {}};
+        }
     }
-    if (!format.empty() && format != "xml") return Error{"unknown input format '" + format + "'", path};
-    Result<XmlModel> xml = read_xml_string(text, path == "-" ? "<stdin>" : path);
-    if (!xml) return xml.error();
-    return Model{std::move(xml->primitives), std::move(xml->hierarchy), {}};
+    Result<ImportResult> imported = import_primitives(path, chosen->second);
+    if (!imported) return imported.error();
+    if (imported->primitives.empty()) return Error{"the file holds no collision primitives", path};
+    return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
 }
 
 Status write_output(const std::string& path, const std::string& content) {
