@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <unordered_map>
 
 #include "hbvh/assert.hpp"
 #include "hbvh/build/set_partition.hpp"
@@ -81,10 +82,20 @@ class Search {
 public:
     Search(const Instance& instance, const SolverBudget& budget)
         : in_(instance), budget_(budget), covered_(instance.node_count, 0), blocked_(instance.candidate_count(), 0),
-          alive_count_(instance.node_count, 0), start_(std::chrono::steady_clock::now()) {
+          alive_count_(instance.node_count, 0), words_((instance.node_count + 63) / 64, 0),
+          zobrist_(instance.node_count), start_(std::chrono::steady_clock::now()) {
         for (std::uint32_t j = 0; j < in_.node_count; ++j)
             alive_count_[j] = static_cast<std::uint32_t>(in_.candidates_of(j).size());
         uncovered_ = in_.node_count;
+        // Fixed keys (not seeded by time), so the search is reproducible.
+        std::uint64_t state = 0x2545f4914f6cdd1dULL;
+        for (std::uint64_t& key : zobrist_) {
+            state += 0x9e3779b97f4a7c15ULL;
+            std::uint64_t z = state;
+            z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+            z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+            key = z ^ (z >> 31);
+        }
     }
 
     /// Seeds the incumbent (an upper bound) with a known cover.
@@ -143,6 +154,8 @@ private:
     void select(std::uint32_t c) {
         for (std::uint32_t j : in_.members_of(c)) {
             covered_[j] = 1;
+            words_[j / 64] |= std::uint64_t{1} << (j % 64);
+            hash_ ^= zobrist_[j];
             --uncovered_;
             for (std::uint32_t d : in_.candidates_of(j))
                 if (blocked_[d]++ == 0)
@@ -161,6 +174,8 @@ private:
                 if (--blocked_[d] == 0)
                     for (std::uint32_t k : in_.members_of(d)) ++alive_count_[k];
             covered_[j] = 0;
+            words_[j / 64] &= ~(std::uint64_t{1} << (j % 64));
+            hash_ ^= zobrist_[j];
             ++uncovered_;
         }
     }
@@ -195,6 +210,11 @@ private:
             rest += min_share(j);
         }
         if (cost_so_far + rest >= best_cost_) return;
+        // Transposition table: different partial solutions often leave the same nodes uncovered (e.g.
+        // {a,b},{c,d} and {a,c},{b,d}); a completion bound proven for that set before prunes here too.
+        const std::uint32_t memo = find_memo();
+        if (memo != no_memo && cost_so_far + memo_bound_[memo] >= best_cost_) return;
+        const double best_at_entry = best_cost_;
 
         // Children cheapest share first. Before descending, a weaker bound that needs no update already
         // prunes many: after choosing c, the other uncovered nodes' shares can only grow, so
@@ -216,6 +236,35 @@ private:
             descend(cost_so_far + in_.cost[c]);
             unselect(c);
         }
+        // Searched to the end: every completion of this set costs at least min(incumbent) - cost so far,
+        // because the search only discards what cannot beat the incumbent, and an improvement found here
+        // is the best completion (infinity: no completion exists). Not after a budget stop.
+        if (!budget_hit_) store_memo(memo, std::min(best_at_entry, best_cost_) - cost_so_far);
+    }
+
+    static constexpr std::uint32_t no_memo = std::numeric_limits<std::uint32_t>::max();
+
+    /// The table entry for the current covered set, or no_memo. Keys are verified word by word, so a
+    /// hash collision can never lend a bound to the wrong set.
+    [[nodiscard]] std::uint32_t find_memo() const {
+        const auto it = memo_index_.find(hash_);
+        if (it == memo_index_.end()) return no_memo;
+        const std::size_t stride = words_.size();
+        if (!std::equal(words_.begin(), words_.end(), memo_keys_.begin() + static_cast<std::ptrdiff_t>(it->second * stride)))
+            return no_memo;
+        return it->second;
+    }
+
+    void store_memo(std::uint32_t memo, double bound) {
+        if (memo != no_memo) {
+            memo_bound_[memo] = std::max(memo_bound_[memo], bound);
+            return;
+        }
+        if (memo_bound_.size() >= memo_capacity || memo_index_.count(hash_) != 0) return;
+        const auto index = static_cast<std::uint32_t>(memo_bound_.size());
+        memo_index_.emplace(hash_, index);
+        memo_keys_.insert(memo_keys_.end(), words_.begin(), words_.end());
+        memo_bound_.push_back(bound);
     }
 
     const Instance& in_;
@@ -224,6 +273,13 @@ private:
     std::vector<std::uint32_t> blocked_;      // chosen candidates sharing a member with this one
     std::vector<std::uint32_t> alive_count_;  // compatible candidates containing this node
     std::uint32_t uncovered_ = 0;
+    std::vector<std::uint64_t> words_;         // covered set as a growable bitset (the memo key)
+    std::vector<std::uint64_t> zobrist_;       // per-node random keys; hash_ = XOR over covered nodes
+    std::uint64_t hash_ = 0;
+    static constexpr std::size_t memo_capacity = 1u << 20;  // entries; bounds memory to ~tens of MB
+    std::unordered_map<std::uint64_t, std::uint32_t> memo_index_;
+    std::vector<std::uint64_t> memo_keys_;
+    std::vector<double> memo_bound_;
     std::vector<std::uint32_t> chosen_;
     std::vector<std::uint32_t> best_;
     double best_cost_ = infinity;
