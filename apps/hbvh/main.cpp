@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
     add_build_command(app, command);
     add_stats_command(app, command);
     add_generate_command(app, command);
+    add_compare_command(app, command);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

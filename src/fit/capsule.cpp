@@ -1,0 +1,185 @@
+// SPDX-License-Identifier: MIT
+// fit_capsule: for each candidate axis direction the smallest capsule along it, then the best of them.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <utility>
+#include <vector>
+
+#include "convex_hull.hpp"
+#include "frames.hpp"
+#include "hbvh/assert.hpp"
+#include "hbvh/fit/fit.hpp"
+#include "min_circle.hpp"
+
+namespace hbvh {
+namespace {
+
+/// The spheres in a frame whose column 0 is the capsule axis: axial coordinate and 2-D cross-section.
+struct Projected {
+    std::vector<double> axial;
+    std::vector<detail::Circle> section;
+};
+
+Projected project(std::span<const Sphere> spheres, const Mat3& frame) {
+    Projected p;
+    p.axial.reserve(spheres.size());
+    p.section.reserve(spheres.size());
+    for (const Sphere& s : spheres) {
+        const Vec3 local = frame.transpose() * s.center;
+        p.axial.push_back(local.x());
+        p.section.push_back({Eigen::Vector2d(local.y(), local.z()), s.radius});
+    }
+    return p;
+}
+
+/// The shortest segment [t0, t1] on the axis line for capsule radius `radius`, where `distance[i]` is
+/// sphere i's distance from the line. Sphere i is inside iff its centre is within radius - r_i of the
+/// segment, i.e. the segment reaches within h_i = sqrt((radius - r_i)^2 - d_i^2) of t_i along the axis:
+/// t0 <= t_i + h_i and t1 >= t_i - h_i. So t0 = min(t_i + h_i), t1 = max(t_i - h_i); when t1 < t0 any
+/// single point of [t1, t0] works and the capsule is a sphere.
+std::pair<double, double> segment_for_radius(const Projected& p, const std::vector<double>& distance, double radius) {
+    double t0 = std::numeric_limits<double>::infinity();
+    double t1 = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < p.axial.size(); ++i) {
+        const double slack = radius - p.section[i].radius;
+        const double h = std::sqrt(std::max(0.0, slack * slack - distance[i] * distance[i]));
+        t0 = std::min(t0, p.axial[i] + h);
+        t1 = std::max(t1, p.axial[i] - h);
+    }
+    if (t1 < t0) t0 = t1 = 0.5 * (t0 + t1);
+    return {t0, t1};
+}
+
+double capsule_volume(double radius, double length) {
+    return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+}
+
+/// A capsule along column 0 of `frame` (a proper rotation) around `spheres`.
+/// exact_line: place the axis at the centre of the minimum enclosing circle of the cross-sections (the
+/// smallest possible radius) and search for a larger radius that shortens the capsule enough to pay off;
+/// otherwise use the cross-sections' bounding-rectangle centre and the smallest radius, a cheap
+/// estimate for ranking directions.
+Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool exact_line) {
+    const Projected p = project(spheres, frame);
+    Eigen::Vector2d line = Eigen::Vector2d::Zero();
+    if (exact_line) {
+        line = detail::min_circle_of_circles(p.section).center;
+    } else {
+        Eigen::Vector2d low = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+        Eigen::Vector2d high = -low;
+        for (const detail::Circle& c : p.section) {
+            low = low.cwiseMin(c.center - Eigen::Vector2d::Constant(c.radius));
+            high = high.cwiseMax(c.center + Eigen::Vector2d::Constant(c.radius));
+        }
+        line = 0.5 * (low + high);
+    }
+    std::vector<double> distance(p.section.size());
+    double min_radius = 0.0;
+    for (std::size_t i = 0; i < p.section.size(); ++i) {
+        distance[i] = (p.section[i].center - line).norm();
+        min_radius = std::max(min_radius, distance[i] + p.section[i].radius);
+    }
+
+    auto volume_at = [&](double r) {
+        const auto [t0, t1] = segment_for_radius(p, distance, r);
+        return capsule_volume(r, t1 - t0);
+    };
+    double radius = min_radius;
+    const auto [first_t0, first_t1] = segment_for_radius(p, distance, min_radius);
+    const double first_length = first_t1 - first_t0;
+    if (exact_line && first_length > 0.0) {
+        // A fatter capsule can be shorter: the end caps then swallow spheres near the ends. Sample radii
+        // geometrically up to one length more, then golden-section search around the best sample.
+        std::vector<double> radii{min_radius};
+        for (double g = 1.0 / 64.0; g <= 1.0; g *= 2.0) radii.push_back(min_radius + g * first_length);
+        std::size_t best = 0;
+        double best_volume = volume_at(radii[0]);
+        for (std::size_t i = 1; i < radii.size(); ++i) {
+            const double v = volume_at(radii[i]);
+            if (v < best_volume) best = i, best_volume = v;
+        }
+        double a = radii[best == 0 ? 0 : best - 1];
+        double b = radii[std::min(best + 1, radii.size() - 1)];
+        radius = radii[best];
+        const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
+        double x1 = b - ratio * (b - a);
+        double x2 = a + ratio * (b - a);
+        double f1 = volume_at(x1);
+        double f2 = volume_at(x2);
+        // 16 steps shrink the bracket to 5e-4 of its width; near the optimum the volume is flat (quadratic),
+        // so the remaining error is far below anything a builder could notice.
+        for (int iteration = 0; iteration < 16; ++iteration) {
+            if (f1 < f2) {
+                b = x2, x2 = x1, f2 = f1;
+                x1 = b - ratio * (b - a), f1 = volume_at(x1);
+            } else {
+                a = x1, x1 = x2, f1 = f2;
+                x2 = a + ratio * (b - a), f2 = volume_at(x2);
+            }
+        }
+        for (const auto& [x, f] : {std::pair{x1, f1}, std::pair{x2, f2}})
+            if (f < best_volume) radius = x, best_volume = f;
+    }
+
+    const auto [t0, t1] = segment_for_radius(p, distance, radius);
+    const Vec3 axis = frame.col(0);
+    const Vec3 base = frame.col(1) * line.x() + frame.col(2) * line.y();
+    return {base + t0 * axis, base + t1 * axis, radius};
+}
+
+/// Grows the radius until Capsule::contains holds for every sphere with zero tolerance: the segment
+/// ends were rounded when mapped back to world coordinates.
+void make_containing(Capsule& capsule, std::span<const Sphere> spheres) {
+    double magnitude = capsule.radius;
+    for (const Sphere& s : spheres) {
+        capsule.radius = std::max(capsule.radius, (s.center - capsule.closest_axis_point(s.center)).norm() + s.radius);
+        magnitude = std::max(magnitude, s.center.cwiseAbs().maxCoeff());
+    }
+    // World coordinates round with their magnitude; a few ulps of it cover a re-evaluation that rounds
+    // differently (fused multiply-add).
+    capsule.radius += magnitude * 0x1.0p-51;
+}
+
+}  // namespace
+
+Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes) {
+    HBVH_ASSERT(!spheres.empty());
+    const detail::HullSummary hull = detail::summarize_hull(spheres);
+
+    // Stage 1: candidate directions. The principal axes of the centres and of the hull, every axis of the
+    // OBB candidate frames (world, DiTO, hints): a capsule's axis usually follows the longest box side.
+    const Mat3 point_frame = detail::principal_frame(detail::point_covariance(spheres));
+    std::vector<Mat3> frames{point_frame, detail::principal_frame(hull.covariance), Mat3::Identity()};
+    for (const Mat3& axes : detail::dito_frames(spheres)) frames.push_back(axes);
+    for (const Mat3& axes : hint_axes) frames.push_back(detail::proper_frame(axes));
+    std::vector<Vec3> directions;
+    directions.reserve(3 * frames.size());
+    for (const Mat3& frame : frames)
+        for (int k = 0; k < 3; ++k) directions.push_back(frame.col(k));
+
+    // Stage 2: rank directions by the cheap capsule around the hull vertices with the largest radius.
+    std::vector<Sphere> proxy;
+    double max_radius = 0.0;
+    for (const Sphere& s : spheres) max_radius = std::max(max_radius, s.radius);
+    for (std::uint32_t i : hull.vertices) proxy.push_back({spheres[i].center, max_radius});
+    std::vector<std::pair<double, std::size_t>> ranked;
+    ranked.reserve(directions.size());
+    for (std::size_t i = 0; i < directions.size(); ++i)
+        ranked.emplace_back(capsule_along(proxy, detail::frame_from_axis(directions[i]), false).volume(), i);
+    const std::size_t keep = std::min<std::size_t>(3, ranked.size());
+    std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
+
+    // Stage 3: exact capsules (minimum enclosing circle, radius search) for the principal axis of the
+    // centres and the best-ranked directions; keep the smallest.
+    Capsule best = capsule_along(spheres, detail::frame_from_axis(point_frame.col(0)), true);
+    for (std::size_t i = 0; i < keep; ++i) {
+        Capsule candidate = capsule_along(spheres, detail::frame_from_axis(directions[ranked[i].second]), true);
+        if (candidate.volume() < best.volume()) best = candidate;
+    }
+    make_containing(best, spheres);
+    return best;
+}
+
+}  // namespace hbvh

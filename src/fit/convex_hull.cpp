@@ -1,0 +1,128 @@
+// SPDX-License-Identifier: MIT
+// Convex hull of sphere centres through qhull's reentrant C API, and the hull-surface covariance.
+#include "convex_hull.hpp"
+
+#include <cstdio>
+#include <memory>
+
+extern "C" {
+#include <libqhull_r/qhull_ra.h>
+}
+
+namespace hbvh::detail {
+namespace {
+
+/// qhull writes diagnostics (precision warnings, "initial simplex is flat") to the FILE it is given and
+/// to stderr when given none. The library must never print, so every run gets this sink instead.
+/// Opened once; stdio locks the FILE, so concurrent fits may share it.
+FILE* null_sink() {
+    static FILE* const sink = std::fopen("/dev/null", "w");
+    return sink;
+}
+
+/// Adds Gottschalk's (1996, eq. in §4 "Fitting OBBs") contribution of triangle (p, q, r) to the running
+/// sums: area-weighted second moments of a uniform density on the triangle.
+void add_triangle(const Vec3& p, const Vec3& q, const Vec3& r, double& area_sum, Vec3& weighted_centroid,
+                  Mat3& second_moment) {
+    const double area = 0.5 * (q - p).cross(r - p).norm();
+    if (!(area > 0.0)) return;
+    const Vec3 centroid = (p + q + r) / 3.0;
+    area_sum += area;
+    weighted_centroid += area * centroid;
+    // E[x x^T] over the triangle = (9 m m^T + p p^T + q q^T + r r^T) / 12.
+    second_moment += (area / 12.0) * (9.0 * centroid * centroid.transpose() + p * p.transpose() +
+                                      q * q.transpose() + r * r.transpose());
+}
+
+/// Every index 0..n-1: the fallback "hull" that keeps all spheres.
+std::vector<std::uint32_t> all_indices(std::size_t n) {
+    std::vector<std::uint32_t> indices(n);
+    for (std::size_t i = 0; i < n; ++i) indices[i] = static_cast<std::uint32_t>(i);
+    return indices;
+}
+
+}  // namespace
+
+Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint32_t> indices) {
+    const std::size_t count = indices.empty() ? spheres.size() : indices.size();
+    auto at = [&](std::size_t i) -> const Vec3& { return spheres[indices.empty() ? i : indices[i]].center; };
+    Vec3 mean = Vec3::Zero();
+    for (std::size_t i = 0; i < count; ++i) mean += at(i);
+    mean /= static_cast<double>(count);
+    Mat3 covariance = Mat3::Zero();
+    for (std::size_t i = 0; i < count; ++i) {
+        const Vec3 d = at(i) - mean;
+        covariance += d * d.transpose();
+    }
+    return covariance / static_cast<double>(count);
+}
+
+HullSummary summarize_hull(std::span<const Sphere> spheres) {
+    HullSummary summary;
+    FILE* sink = null_sink();
+    // Fewer than four points cannot span a solid; qhull would only report an error.
+    if (spheres.size() < 4 || sink == nullptr) {
+        summary.vertices = all_indices(spheres.size());
+        summary.covariance = point_covariance(spheres);
+        return summary;
+    }
+
+    // Centre the points first: qhull's precision thresholds are relative to the largest coordinate, so a
+    // small cluster far from the origin (1e6 away) would otherwise look flat.
+    Vec3 mean = Vec3::Zero();
+    for (const Sphere& s : spheres) mean += s.center;
+    mean /= static_cast<double>(spheres.size());
+    std::vector<coordT> coordinates(3 * spheres.size());
+    for (std::size_t i = 0; i < spheres.size(); ++i)
+        for (int k = 0; k < 3; ++k) coordinates[3 * i + static_cast<std::size_t>(k)] = spheres[i].center[k] - mean[k];
+
+    auto state = std::make_unique<qhT>();
+    qhT* qh = state.get();
+    qh_zero(qh, sink);
+    // 'Qt' triangulates merged facets so that every facet is a triangle for the area weighting.
+    char command[] = "qhull Qt";
+    const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(spheres.size()), coordinates.data(), False, command,
+                                       nullptr, sink);
+    if (exit_code == 0) {
+        double area_sum = 0.0;
+        Vec3 weighted_centroid = Vec3::Zero();
+        Mat3 second_moment = Mat3::Zero();
+        facetT* facet = nullptr;
+        FORALLfacets {
+            // Triangulated output has three vertices per facet; fan anything else to stay safe.
+            const int vertex_count = qh_setsize(qh, facet->vertices);
+            if (vertex_count < 3) continue;
+            auto vertex_point = [&](int i) {
+                const auto* vertex = static_cast<vertexT*>(SETelem_(facet->vertices, i));
+                return Vec3(vertex->point[0], vertex->point[1], vertex->point[2]);
+            };
+            const Vec3 first = vertex_point(0);
+            for (int i = 1; i + 1 < vertex_count; ++i)
+                add_triangle(first, vertex_point(i), vertex_point(i + 1), area_sum, weighted_centroid, second_moment);
+        }
+        vertexT* vertex = nullptr;
+        FORALLvertices {
+            const int id = qh_pointid(qh, vertex->point);
+            if (id >= 0 && static_cast<std::size_t>(id) < spheres.size())
+                summary.vertices.push_back(static_cast<std::uint32_t>(id));
+        }
+        if (area_sum > 0.0 && summary.vertices.size() >= 4) {
+            const Vec3 hull_centroid = weighted_centroid / area_sum;
+            summary.covariance = second_moment / area_sum - hull_centroid * hull_centroid.transpose();
+            summary.is_solid = true;
+        }
+    }
+    qh_freeqhull(qh, !qh_ALL);
+    int current_long = 0;
+    int total_long = 0;
+    qh_memfreeshort(qh, &current_long, &total_long);
+
+    if (!summary.is_solid) {
+        // Flat boxes, collinear points, duplicates: qhull refuses a 3-D hull, so use the raw centres.
+        summary.vertices = all_indices(spheres.size());
+        summary.covariance = point_covariance(spheres);
+    }
+    return summary;
+}
+
+}  // namespace hbvh::detail

@@ -1,0 +1,32 @@
+// SPDX-License-Identifier: MIT
+// Internal: the convex hull of the sphere centres and its covariance, the input of Gottschalk's OBB.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "hbvh/geometry/sphere.hpp"
+
+namespace hbvh::detail {
+
+/// What the fitters need from the convex hull of a set of sphere centres.
+struct HullSummary {
+    /// Indices (into the input) of the hull's vertices. When the hull is degenerate (fewer than four
+    /// points, or all coplanar or collinear) this lists every input sphere, so callers never lose one.
+    std::vector<std::uint32_t> vertices;
+    /// Covariance of the hull surface (Gottschalk 1996, area-weighted over triangles) or, when the hull
+    /// is degenerate, of the raw centres. Symmetric positive semi-definite.
+    Mat3 covariance = Mat3::Zero();
+    /// True when qhull produced a full-dimensional hull with positive surface area.
+    bool is_solid = false;
+};
+
+/// Convex hull of the centres of `spheres` (radii are ignored). Never prints, never throws.
+/// Precondition: spheres non-empty.
+[[nodiscard]] HullSummary summarize_hull(std::span<const Sphere> spheres);
+
+/// Covariance of the centres of `spheres[indices]` (all spheres when `indices` is empty), equally weighted.
+[[nodiscard]] Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint32_t> indices = {});
+
+}  // namespace hbvh::detail

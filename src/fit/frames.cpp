@@ -1,0 +1,222 @@
+// SPDX-License-Identifier: MIT
+// Candidate orientations (principal axes, DiTO frames, local refinement) and per-frame box evaluation.
+#include "frames.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Eigenvalues>
+
+namespace hbvh::detail {
+namespace {
+
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+/// Any unit vector perpendicular to the unit vector `u`: cross with the world axis least aligned with it.
+Vec3 any_perpendicular(const Vec3& u) {
+    Eigen::Index least = 0;
+    u.cwiseAbs().minCoeff(&least);
+    return u.cross(Vec3::Unit(least)).normalized();
+}
+
+/// The 13 directions of DiTO-26 (Larsson & Källberg 2011, §2): the face, edge and vertex normals of
+/// a cube, one of each antipodal pair. Normalised so that support values with radii are distances.
+const std::array<Vec3, 13>& dito_normals() {
+    static const std::array<Vec3, 13> normals = [] {
+        std::array<Vec3, 13> n{Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 1),  Vec3(1, 1, -1),
+                               Vec3(1, -1, 1), Vec3(1, -1, -1), Vec3(1, 1, 0),  Vec3(1, -1, 0), Vec3(1, 0, 1),
+                               Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1)};
+        for (Vec3& v : n) v.normalize();
+        return n;
+    }();
+    return normals;
+}
+
+/// Squared distance from `p` to the line through `a` with unit direction `u`.
+double squared_distance_to_line(const Vec3& p, const Vec3& a, const Vec3& u) {
+    const Vec3 d = p - a;
+    return (d - d.dot(u) * u).squaredNorm();
+}
+
+/// A tiny relative pad (about 4 ulps of `magnitude`) that keeps containment true even when a
+/// caller's re-evaluation rounds differently (e.g. with fused multiply-add contraction).
+double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
+
+}  // namespace
+
+Mat3 proper_frame(const Mat3& axes) {
+    Vec3 x = axes.col(0);
+    x = x.norm() > 0.0 ? Vec3(x.normalized()) : Vec3::UnitX();
+    Vec3 y = axes.col(1) - axes.col(1).dot(x) * x;
+    // A column that is (nearly) parallel to the first carries no orientation; pick any perpendicular.
+    y = y.norm() > 1e-12 * std::max(1.0, axes.col(1).norm()) ? Vec3(y.normalized()) : any_perpendicular(x);
+    Mat3 frame;
+    frame.col(0) = x;
+    frame.col(1) = y;
+    frame.col(2) = x.cross(y);  // completes a right-handed frame, so det = +1
+    return frame;
+}
+
+Mat3 principal_frame(const Mat3& covariance) {
+    const Eigen::SelfAdjointEigenSolver<Mat3> solver(covariance);
+    if (solver.info() != Eigen::Success) return Mat3::Identity();
+    // Eigen sorts eigenvalues ascending; put the largest spread first.
+    Mat3 axes;
+    axes.col(0) = solver.eigenvectors().col(2);
+    axes.col(1) = solver.eigenvectors().col(1);
+    axes.col(2) = solver.eigenvectors().col(0);
+    return proper_frame(axes);
+}
+
+Mat3 frame_from_axis(const Vec3& axis) {
+    if (!(axis.norm() > 0.0)) return Mat3::Identity();
+    const Vec3 u = axis.normalized();
+    Mat3 axes;
+    axes.col(0) = u;
+    axes.col(1) = any_perpendicular(u);
+    axes.col(2) = Vec3::Zero();
+    return proper_frame(axes);
+}
+
+std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
+    // Stage 1: extremal spheres along each fixed direction (support value c.n +- r).
+    std::vector<Vec3> extremal;
+    for (const Vec3& n : dito_normals()) {
+        double low = infinity;
+        double high = -infinity;
+        const Sphere* low_sphere = &spheres.front();
+        const Sphere* high_sphere = &spheres.front();
+        for (const Sphere& s : spheres) {
+            const double t = s.center.dot(n);
+            if (t - s.radius < low) low = t - s.radius, low_sphere = &s;
+            if (t + s.radius > high) high = t + s.radius, high_sphere = &s;
+        }
+        extremal.push_back(low_sphere->center);
+        extremal.push_back(high_sphere->center);
+    }
+
+    // Stage 2: the farthest pair among the extremal points is the first triangle edge. DiTO only compares
+    // the pairs along one direction; all pairs of at most 26 points is still cheap and never worse.
+    std::size_t a = 0;
+    std::size_t b = 0;
+    double farthest = 0.0;
+    for (std::size_t i = 0; i < extremal.size(); ++i)
+        for (std::size_t j = i + 1; j < extremal.size(); ++j) {
+            const double d = (extremal[i] - extremal[j]).squaredNorm();
+            if (d > farthest) farthest = d, a = i, b = j;
+        }
+    if (!(farthest > 0.0)) return {};  // all centres coincide: every frame is equally good
+    // Below this (relative to the set's spread) a triangle or tetrahedron counts as flat.
+    const double tiny = 1e-12 * std::sqrt(farthest);
+    const Vec3 p0 = extremal[a];
+    const Vec3 p1 = extremal[b];
+    const Vec3 u = (p1 - p0).normalized();
+
+    // Stage 3: the extremal point farthest from that line closes the base triangle.
+    std::size_t c = 0;
+    double off_line = 0.0;
+    for (std::size_t i = 0; i < extremal.size(); ++i) {
+        const double d = squared_distance_to_line(extremal[i], p0, u);
+        if (d > off_line) off_line = d, c = i;
+    }
+    if (!(std::sqrt(off_line) > tiny)) return {frame_from_axis(u)};  // collinear: only the line's direction matters
+    const Vec3 p2 = extremal[c];
+    const Vec3 normal = (p1 - p0).cross(p2 - p0).normalized();
+
+    // Stage 4: the apexes above and below the base plane make a ditetrahedron of up to 7 triangles.
+    std::vector<std::array<Vec3, 3>> triangles{{p0, p1, p2}};
+    std::size_t top = 0;
+    std::size_t bottom = 0;
+    for (std::size_t i = 0; i < extremal.size(); ++i) {
+        const double h = (extremal[i] - p0).dot(normal);
+        if (h > (extremal[top] - p0).dot(normal)) top = i;
+        if (h < (extremal[bottom] - p0).dot(normal)) bottom = i;
+    }
+    for (std::size_t apex : {top, bottom}) {
+        const Vec3 q = extremal[apex];
+        if (!(std::abs((q - p0).dot(normal)) > tiny)) continue;
+        triangles.push_back({p0, p1, q});
+        triangles.push_back({p1, p2, q});
+        triangles.push_back({p2, p0, q});
+    }
+
+    // Stage 5: each edge of each triangle, with the triangle's normal, spans one frame.
+    std::vector<Mat3> frames;
+    for (const auto& t : triangles) {
+        const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if (!(n.norm() > tiny * std::sqrt(farthest))) continue;
+        for (int e = 0; e < 3; ++e) {
+            const Vec3 edge = t[static_cast<std::size_t>((e + 1) % 3)] - t[static_cast<std::size_t>(e)];
+            if (!(edge.norm() > tiny)) continue;
+            Mat3 axes;
+            axes.col(0) = edge;
+            axes.col(1) = n;
+            axes.col(2) = Vec3::Zero();
+            frames.push_back(proper_frame(axes));
+        }
+    }
+    return frames;
+}
+
+Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
+    const Mat3 to_local = rotation.transpose();
+    Vec3 low = Vec3::Constant(infinity);
+    Vec3 high = Vec3::Constant(-infinity);
+    for (const Sphere& s : spheres) {
+        const Vec3 local = to_local * s.center;
+        low = low.cwiseMin(local - Vec3::Constant(s.radius));
+        high = high.cwiseMax(local + Vec3::Constant(s.radius));
+    }
+    Obb box{rotation * (0.5 * (low + high)), rotation, 0.5 * (high - low)};
+    // Re-centring rounds; grow by whatever the containment test itself measures, so it holds exactly.
+    for (const Sphere& s : spheres) {
+        const Vec3 local = to_local * (s.center - box.center);
+        box.half_extents = box.half_extents.cwiseMax(Vec3(local.cwiseAbs().array() + s.radius));
+    }
+    // Local coordinates are differences of nearby points, so their rounding scales with the box, not
+    // with its distance from the origin.
+    box.half_extents.array() += rounding_pad(box.half_extents.maxCoeff());
+    return box;
+}
+
+double proxy_obb_volume(const PointProxy& proxy, const Mat3& rotation) {
+    const Mat3 to_local = rotation.transpose();
+    Vec3 low = Vec3::Constant(infinity);
+    Vec3 high = Vec3::Constant(-infinity);
+    for (const Vec3& p : proxy.points) {
+        const Vec3 local = to_local * p;
+        low = low.cwiseMin(local);
+        high = high.cwiseMax(local);
+    }
+    return (high - low + Vec3::Constant(2.0 * proxy.max_radius)).prod();
+}
+
+Mat3 refine_frame(const PointProxy& proxy, const Mat3& rotation) {
+    // Pattern search: try +-step about each box axis, keep any improvement, halve the step when none
+    // helps. Start at ~6 degrees (candidate frames are usually close) and stop below ~0.01 degree.
+    Mat3 best = rotation;
+    double best_volume = proxy_obb_volume(proxy, best);
+    double step = 0.1;
+    int evaluations = 0;
+    constexpr int max_evaluations = 180;
+    while (step > 2e-4 && evaluations < max_evaluations) {
+        bool improved = false;
+        for (int axis = 0; axis < 3 && evaluations < max_evaluations; ++axis)
+            for (double sign : {1.0, -1.0}) {
+                const Mat3 candidate = best * Eigen::AngleAxisd(sign * step, Vec3::Unit(axis)).toRotationMatrix();
+                const double v = proxy_obb_volume(proxy, candidate);
+                ++evaluations;
+                if (v < best_volume * (1.0 - 1e-12)) {
+                    best = candidate;
+                    best_volume = v;
+                    improved = true;
+                }
+            }
+        if (!improved) step *= 0.5;
+    }
+    return proper_frame(best);
+}
+
+}  // namespace hbvh::detail

@@ -1,0 +1,70 @@
+// SPDX-License-Identifier: MIT
+// fit_sphere: the exact minimum enclosing sphere of spheres (and its 2-D twin for capsules), via CGAL.
+#include <algorithm>
+#include <vector>
+
+#include <CGAL/Min_sphere_of_spheres_d.h>
+#include <CGAL/Min_sphere_of_spheres_d_traits_2.h>
+#include <CGAL/Min_sphere_of_spheres_d_traits_3.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include "hbvh/assert.hpp"
+#include "hbvh/fit/fit.hpp"
+#include "min_circle.hpp"
+
+namespace hbvh {
+namespace {
+
+// CGAL's Min_sphere_of_spheres_d (Fischer & Gärtner's algorithm) is exact for spheres of differing radii,
+// unlike Welzl-style point algorithms. The default traits (no square-root field, farthest-first heuristic)
+// work in plain double, which is all the result is stored in anyway.
+using Kernel = CGAL::Simple_cartesian<double>;
+using Traits3 = CGAL::Min_sphere_of_spheres_d_traits_3<Kernel, double>;
+using Traits2 = CGAL::Min_sphere_of_spheres_d_traits_2<Kernel, double>;
+
+/// A few ulps of `magnitude`: CGAL's centre is rounded, and callers may re-evaluate containment
+/// with different rounding (fused multiply-add), so a radius that is merely tight could miss by an ulp.
+double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
+
+}  // namespace
+
+Sphere fit_sphere(std::span<const Sphere> spheres) {
+    HBVH_ASSERT(!spheres.empty());
+    std::vector<Traits3::Sphere> input;
+    input.reserve(spheres.size());
+    for (const Sphere& s : spheres)
+        input.emplace_back(Kernel::Point_3(s.center.x(), s.center.y(), s.center.z()), s.radius);
+    CGAL::Min_sphere_of_spheres_d<Traits3> solver(input.begin(), input.end());
+
+    Sphere result;
+    auto coordinate = solver.center_cartesian_begin();
+    for (int k = 0; k < 3; ++k, ++coordinate) result.center[k] = *coordinate;
+    result.radius = solver.radius();
+    // CGAL's answer is optimal up to rounding; measure containment the way Sphere::contains does and grow.
+    for (const Sphere& s : spheres) result.radius = std::max(result.radius, (s.center - result.center).norm() + s.radius);
+    // The distances are of nearby points, so their rounding scales with the radius, not the coordinates.
+    result.radius += rounding_pad(result.radius);
+    return result;
+}
+
+namespace detail {
+
+Circle min_circle_of_circles(std::span<const Circle> circles) {
+    HBVH_ASSERT(!circles.empty());
+    std::vector<Traits2::Sphere> input;
+    input.reserve(circles.size());
+    for (const Circle& c : circles) input.emplace_back(Kernel::Point_2(c.center.x(), c.center.y()), c.radius);
+    CGAL::Min_sphere_of_spheres_d<Traits2> solver(input.begin(), input.end());
+
+    Circle result;
+    auto coordinate = solver.center_cartesian_begin();
+    result.center.x() = *coordinate;
+    ++coordinate;
+    result.center.y() = *coordinate;
+    result.radius = solver.radius();
+    for (const Circle& c : circles) result.radius = std::max(result.radius, (c.center - result.center).norm() + c.radius);
+    return result;
+}
+
+}  // namespace detail
+}  // namespace hbvh

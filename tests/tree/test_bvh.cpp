@@ -1,0 +1,147 @@
+// SPDX-License-Identifier: MIT
+// TreeAssembler layout, level views, validate() and the survey's cost on hand-computed examples.
+#include <gtest/gtest.h>
+
+#include <numbers>
+
+#include "hbvh/tree/bvh.hpp"
+#include "hbvh/tree/stats.hpp"
+#include "hbvh/tree/validate.hpp"
+
+namespace hbvh {
+namespace {
+
+Primitive unit_box_at(double x) { return {Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, "box"}; }
+
+/// Four unit boxes on the x axis at 0, 2, 4, 6, grouped ((0,1),(2,3)).
+Bvh two_pairs() {
+    std::vector<Primitive> primitives{unit_box_at(0), unit_box_at(2), unit_box_at(4), unit_box_at(6)};
+    TreeAssembler assembler(primitives);
+    std::uint32_t leaves[4];
+    for (std::uint32_t i = 0; i < 4; ++i) leaves[i] = assembler.add_leaf(i);
+    const std::uint32_t left[] = {leaves[0], leaves[1]};
+    const std::uint32_t right[] = {leaves[2], leaves[3]};
+    const std::uint32_t a = assembler.add_group(left, Aabb{Vec3(0, 0, 0), Vec3(3, 1, 1)});
+    const std::uint32_t b = assembler.add_group(right, Aabb{Vec3(4, 0, 0), Vec3(7, 1, 1)});
+    const std::uint32_t groups[] = {a, b};
+    const std::uint32_t root = assembler.add_group(groups, Aabb{Vec3(0, 0, 0), Vec3(7, 1, 1)});
+    return std::move(assembler).finish(root);
+}
+
+TEST(TreeAssembler, LaysOutBreadthFirstWithContiguousChildren) {
+    const Bvh bvh = two_pairs();
+    ASSERT_EQ(bvh.nodes.size(), 7u);
+    EXPECT_EQ(bvh.root().child_count, 2u);
+    EXPECT_EQ(bvh.root().first_child, 1u);
+    EXPECT_EQ(bvh.nodes[1].first_child, 3u);
+    EXPECT_EQ(bvh.nodes[2].first_child, 5u);
+    const auto level_view = levels(bvh);
+    ASSERT_EQ(level_view.size(), 3u);
+    EXPECT_EQ(level_view[1], (std::vector<std::uint32_t>{1, 2}));
+    EXPECT_EQ(level_view[2].size(), 4u);
+    EXPECT_EQ(covered_primitives(bvh, 2), (std::vector<std::uint32_t>{2, 3}));
+    EXPECT_TRUE(validate(bvh).has_value());
+}
+
+TEST(TreeAssembler, CollapsesSingleChildChains) {
+    std::vector<Primitive> primitives{unit_box_at(0), unit_box_at(2)};
+    TreeAssembler assembler(primitives);
+    const std::uint32_t a = assembler.add_leaf(0);
+    const std::uint32_t b = assembler.add_leaf(1);
+    const std::uint32_t only_b[] = {b};
+    const std::uint32_t wrapper = assembler.add_group(only_b, Aabb{Vec3(2, 0, 0), Vec3(3, 1, 1)});
+    const std::uint32_t pair[] = {a, wrapper};
+    const std::uint32_t root = assembler.add_group(pair, Aabb{Vec3(0, 0, 0), Vec3(3, 1, 1)});
+    const std::uint32_t only_root[] = {root};
+    const Bvh bvh = std::move(assembler).finish(assembler.add_group(only_root, Aabb{Vec3(0, 0, 0), Vec3(3, 1, 1)}));
+    ASSERT_EQ(bvh.nodes.size(), 3u);
+    EXPECT_TRUE(bvh.nodes[1].is_leaf());
+    EXPECT_TRUE(bvh.nodes[2].is_leaf());
+    EXPECT_TRUE(validate(bvh).has_value());
+}
+
+TEST(Validate, RejectsABvThatMissesAPrimitive) {
+    Bvh bvh = two_pairs();
+    bvh.nodes[1].volume = Aabb{Vec3(0, 0, 0), Vec3(2.5, 1, 1)};  // misses the second box's far half
+    const Status status = validate(bvh);
+    ASSERT_FALSE(status.has_value());
+    EXPECT_NE(status.error().message.find("node 1"), std::string::npos);
+}
+
+TEST(Validate, RejectsDuplicateAndMissingPrimitives) {
+    Bvh bvh = two_pairs();
+    bvh.nodes[6].primitive = 0;
+    EXPECT_FALSE(validate(bvh).has_value());
+}
+
+TEST(Validate, RejectsSingleChildInnerNodes) {
+    Bvh bvh = two_pairs();
+    bvh.nodes[0].child_count = 1;
+    EXPECT_FALSE(validate(bvh).has_value());
+}
+
+TEST(Stats, CostIsChildrenTimesVolumeSummedOverInnerNodes) {
+    // Hand computation: root 2 children x 7 + two groups 2 x 3 each = 14 + 12 = 26.
+    const Bvh bvh = two_pairs();
+    EXPECT_DOUBLE_EQ(cost(bvh), 26.0);
+    const Stats stats = compute_stats(bvh);
+    EXPECT_DOUBLE_EQ(stats.cost, 26.0);
+    EXPECT_EQ(stats.height, 2u);
+    EXPECT_EQ(stats.inner_nodes, 3u);
+    EXPECT_EQ(stats.leaves, 4u);
+    EXPECT_DOUBLE_EQ(stats.branching.mean, 2.0);
+    // Tightness: root 7 / (3 + 3); groups 3 / (1 + 1).
+    EXPECT_DOUBLE_EQ(stats.tightness.min, 7.0 / 6.0);
+    EXPECT_DOUBLE_EQ(stats.tightness.max, 1.5);
+    EXPECT_DOUBLE_EQ(stats.leaf_depth.mean, 2.0);
+    EXPECT_DOUBLE_EQ(stats.overlap, 0.0);  // siblings are disjoint (they touch nowhere)
+    EXPECT_EQ(stats.types[0], 7u);
+}
+
+TEST(Stats, WeightsScaleEachTypesVolume) {
+    VolumePolicy policy;
+    policy.weight[static_cast<std::size_t>(BvType::aabb)] = 2.0;
+    EXPECT_DOUBLE_EQ(cost(two_pairs(), policy), 52.0);
+}
+
+TEST(Stats, OverlapMeasuresSiblingAabbIntersection) {
+    std::vector<Primitive> primitives{{Aabb{Vec3(0, 0, 0), Vec3(2, 1, 1)}, ""}, {Aabb{Vec3(1, 0, 0), Vec3(3, 1, 1)}, ""}};
+    TreeAssembler assembler(primitives);
+    const std::uint32_t leaves[] = {assembler.add_leaf(0), assembler.add_leaf(1)};
+    const Bvh bvh = std::move(assembler).finish(assembler.add_group(leaves, Aabb{Vec3(0, 0, 0), Vec3(3, 1, 1)}));
+    // Intersection 1 over sibling volume 2 + 2.
+    EXPECT_DOUBLE_EQ(compute_stats(bvh).overlap, 0.25);
+}
+
+TEST(BoundingVolume, CapsuleVolumeIsCylinderPlusBall) {
+    const Capsule capsule{Vec3(0, 0, 0), Vec3(0, 0, 2), 0.5};
+    EXPECT_DOUBLE_EQ(capsule.volume(), std::numbers::pi * 0.25 * 2 + 4.0 / 3.0 * std::numbers::pi * 0.125);
+}
+
+TEST(BoundingVolume, TransformedAabbIsExactObb) {
+    const BoundingVolume box = Aabb{Vec3(0, 0, 0), Vec3(1, 2, 3)};
+    RigidTransform t;
+    t.rotation = Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()).toRotationMatrix();
+    t.translation = Vec3(5, -1, 2);
+    const BoundingVolume moved = transformed(box, t);
+    EXPECT_NEAR(volume(moved), 6.0, 1e-12);
+    for (const Sphere& corner : generating_spheres(box)) EXPECT_TRUE(contains(moved, corner.transformed(t), 1e-12));
+}
+
+TEST(VolumePolicy, ParsesTypesAndWeights) {
+    const Result<VolumePolicy> types = parse_allowed_types("aabb, sphere");
+    ASSERT_TRUE(types.has_value());
+    EXPECT_TRUE(types->is_allowed(BvType::aabb));
+    EXPECT_FALSE(types->is_allowed(BvType::obb));
+    EXPECT_FALSE(parse_allowed_types("aabb,cone").has_value());
+    EXPECT_FALSE(parse_allowed_types("").has_value());
+    const Result<VolumePolicy> weights = parse_type_weights("obb=1.5,capsule=1.2");
+    ASSERT_TRUE(weights.has_value());
+    EXPECT_DOUBLE_EQ(weights->weight_of(BvType::obb), 1.5);
+    EXPECT_FALSE(parse_type_weights("obb=0").has_value());
+    EXPECT_FALSE(parse_type_weights("obb=nan").has_value());
+    EXPECT_FALSE(parse_type_weights("obb").has_value());
+}
+
+}  // namespace
+}  // namespace hbvh
