@@ -7,6 +7,7 @@
 #include <span>
 #include <string_view>
 
+#include "hbvh/build/optimal.hpp"
 #include "hbvh/build/report.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/result.hpp"
@@ -16,6 +17,7 @@ namespace hbvh {
 
 enum class Algorithm {
     two_level,
+    optimal,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -34,6 +36,7 @@ struct AlgorithmInfo {
 struct BuildOptions {
     VolumePolicy policy;
     BuildReport* report = nullptr;  ///< Filled when non-null.
+    OptimalOptions optimal;         ///< For Algorithm::optimal.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
