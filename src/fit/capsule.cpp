@@ -150,24 +150,22 @@ Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_
 
     // Stage 1: candidate directions. The principal axes of the centres and of the hull, every axis of the
     // OBB candidate frames (world, DiTO, hints): a capsule's axis usually follows the longest box side.
+    const detail::SphereProxy proxy = detail::make_proxy(spheres, hull);
     const Mat3 point_frame = detail::principal_frame(detail::point_covariance(spheres));
     std::vector<Mat3> frames{point_frame, detail::principal_frame(hull.covariance), Mat3::Identity()};
     for (const Mat3& axes : detail::dito_frames(spheres)) frames.push_back(axes);
-    for (const Mat3& axes : hint_axes) frames.push_back(detail::proper_frame(axes));
+    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) frames.push_back(axes);
     std::vector<Vec3> directions;
     directions.reserve(3 * frames.size());
     for (const Mat3& frame : frames)
         for (int k = 0; k < 3; ++k) directions.push_back(frame.col(k));
 
-    // Stage 2: rank directions by the cheap capsule around the hull vertices with the largest radius.
-    std::vector<Sphere> proxy;
-    double max_radius = 0.0;
-    for (const Sphere& s : spheres) max_radius = std::max(max_radius, s.radius);
-    for (std::uint32_t i : hull.vertices) proxy.push_back({spheres[i].center, max_radius});
+    // Stage 2: rank directions by a cheap capsule (axis through the centre of the cross-sections' bounding
+    // rectangle) around the proxy: hull vertices and spheres of positive radius.
     std::vector<std::pair<double, std::size_t>> ranked;
     ranked.reserve(directions.size());
     for (std::size_t i = 0; i < directions.size(); ++i)
-        ranked.emplace_back(capsule_along(proxy, detail::frame_from_axis(directions[i]), false).volume(), i);
+        ranked.emplace_back(capsule_along(proxy.spheres, detail::frame_from_axis(directions[i]), false).volume(), i);
     const std::size_t keep = std::min<std::size_t>(3, ranked.size());
     std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
 

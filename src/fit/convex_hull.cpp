@@ -2,8 +2,10 @@
 // Convex hull of sphere centres through qhull's reentrant C API, and the hull-surface covariance.
 #include "convex_hull.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <utility>
 
 extern "C" {
 #include <libqhull_r/qhull_ra.h>
@@ -22,16 +24,31 @@ FILE* null_sink() {
 
 /// Adds Gottschalk's (1996, eq. in §4 "Fitting OBBs") contribution of triangle (p, q, r) to the running
 /// sums: area-weighted second moments of a uniform density on the triangle.
-void add_triangle(const Vec3& p, const Vec3& q, const Vec3& r, double& area_sum, Vec3& weighted_centroid,
-                  Mat3& second_moment) {
+/// Returns the triangle's area.
+double add_triangle(const Vec3& p, const Vec3& q, const Vec3& r, double& area_sum, Vec3& weighted_centroid,
+                    Mat3& second_moment) {
     const double area = 0.5 * (q - p).cross(r - p).norm();
-    if (!(area > 0.0)) return;
+    if (!(area > 0.0)) return 0.0;
     const Vec3 centroid = (p + q + r) / 3.0;
     area_sum += area;
     weighted_centroid += area * centroid;
     // E[x x^T] over the triangle = (9 m m^T + p p^T + q q^T + r r^T) / 12.
     second_moment += (area / 12.0) * (9.0 * centroid * centroid.transpose() + p * p.transpose() +
                                       q * q.transpose() + r * r.transpose());
+    return area;
+}
+
+/// Largest faces first, merging normals within ~0.01 degree (Qt splits flat faces into triangles).
+std::vector<Vec3> distinct_normals(std::vector<std::pair<double, Vec3>> faces) {
+    std::stable_sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
+    std::vector<Vec3> normals;
+    for (const auto& [area, normal] : faces) {
+        if (normals.size() >= max_face_normals) break;
+        const bool seen = std::any_of(normals.begin(), normals.end(),
+                                      [&](const Vec3& n) { return n.dot(normal) > 1.0 - 1e-8; });
+        if (!seen) normals.push_back(normal);
+    }
+    return normals;
 }
 
 /// Every index 0..n-1: the fallback "hull" that keeps all spheres.
@@ -87,6 +104,7 @@ HullSummary summarize_hull(std::span<const Sphere> spheres) {
         double area_sum = 0.0;
         Vec3 weighted_centroid = Vec3::Zero();
         Mat3 second_moment = Mat3::Zero();
+        std::vector<std::pair<double, Vec3>> faces;
         facetT* facet = nullptr;
         FORALLfacets {
             // Triangulated output has three vertices per facet; fan anything else to stay safe.
@@ -97,8 +115,12 @@ HullSummary summarize_hull(std::span<const Sphere> spheres) {
                 return Vec3(vertex->point[0], vertex->point[1], vertex->point[2]);
             };
             const Vec3 first = vertex_point(0);
+            double face_area = 0.0;
             for (int i = 1; i + 1 < vertex_count; ++i)
-                add_triangle(first, vertex_point(i), vertex_point(i + 1), area_sum, weighted_centroid, second_moment);
+                face_area += add_triangle(first, vertex_point(i), vertex_point(i + 1), area_sum, weighted_centroid,
+                                          second_moment);
+            const Vec3 normal(facet->normal[0], facet->normal[1], facet->normal[2]);
+            if (face_area > 0.0 && normal.norm() > 0.5) faces.emplace_back(face_area, normal.normalized());
         }
         vertexT* vertex = nullptr;
         FORALLvertices {
@@ -109,6 +131,7 @@ HullSummary summarize_hull(std::span<const Sphere> spheres) {
         if (area_sum > 0.0 && summary.vertices.size() >= 4) {
             const Vec3 hull_centroid = weighted_centroid / area_sum;
             summary.covariance = second_moment / area_sum - hull_centroid * hull_centroid.transpose();
+            summary.face_normals = distinct_normals(std::move(faces));
             summary.is_solid = true;
         }
     }

@@ -10,6 +10,9 @@
 
 namespace hbvh::detail {
 
+/// Faces beyond this many (the smallest ones) are not reported: they rarely orient the best box.
+inline constexpr std::size_t max_face_normals = 48;
+
 /// What the fitters need from the convex hull of a set of sphere centres.
 struct HullSummary {
     /// Indices (into the input) of the hull's vertices. When the hull is degenerate (fewer than four
@@ -18,6 +21,9 @@ struct HullSummary {
     /// Covariance of the hull surface (Gottschalk 1996, area-weighted over triangles) or, when the hull
     /// is degenerate, of the raw centres. Symmetric positive semi-definite.
     Mat3 covariance = Mat3::Zero();
+    /// Unit outward normals of the hull's faces, largest face first, near-duplicates (the triangles of one
+    /// flat face) merged, at most max_face_normals. Empty when the hull is degenerate.
+    std::vector<Vec3> face_normals;
     /// True when qhull produced a full-dimensional hull with positive surface area.
     bool is_solid = false;
 };

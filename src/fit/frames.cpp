@@ -44,6 +44,28 @@ double squared_distance_to_line(const Vec3& p, const Vec3& a, const Vec3& u) {
 /// caller's re-evaluation rounds differently (e.g. with fused multiply-add contraction).
 double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
 
+/// Convex hull of 2-D points, counter-clockwise, without collinear points (Andrew's monotone chain).
+std::vector<Eigen::Vector2d> hull_2d(std::vector<Eigen::Vector2d> points) {
+    std::sort(points.begin(), points.end(),
+              [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+    if (points.size() < 3) return points;
+    auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+        return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
+    };
+    std::vector<Eigen::Vector2d> hull(2 * points.size());
+    std::size_t k = 0;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+        hull[k++] = points[i];
+    }
+    for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
+        while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+        hull[k++] = points[i];
+    }
+    hull.resize(k - 1);
+    return hull;
+}
+
 }  // namespace
 
 Mat3 proper_frame(const Mat3& axes) {
@@ -160,6 +182,81 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     return frames;
 }
 
+SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull) {
+    SphereProxy proxy;
+    std::vector<bool> taken(spheres.size(), false);
+    for (std::uint32_t i : hull.vertices) {
+        taken[i] = true;
+        proxy.hull_points.push_back(spheres[i].center);
+    }
+    for (std::size_t i = 0; i < spheres.size(); ++i) {
+        if (taken[i] || spheres[i].radius > 0.0) proxy.spheres.push_back(spheres[i]);
+        proxy.max_radius = std::max(proxy.max_radius, spheres[i].radius);
+    }
+    return proxy;
+}
+
+std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> hints, std::size_t limit) {
+    std::vector<Mat3> frames;
+    frames.reserve(hints.size());
+    for (const Mat3& axes : hints) frames.push_back(proper_frame(axes));
+    if (frames.size() <= limit) return frames;
+    std::vector<std::pair<double, std::size_t>> ranked;
+    ranked.reserve(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const Mat3 to_local = frames[i].transpose();
+        Vec3 low = Vec3::Constant(infinity);
+        Vec3 high = Vec3::Constant(-infinity);
+        for (const Vec3& p : proxy.hull_points) {
+            const Vec3 local = to_local * p;
+            low = low.cwiseMin(local);
+            high = high.cwiseMax(local);
+        }
+        ranked.emplace_back((high - low + Vec3::Constant(2.0 * proxy.max_radius)).prod(), i);
+    }
+    std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(limit), ranked.end());
+    std::vector<Mat3> selected;
+    selected.reserve(limit);
+    for (std::size_t i = 0; i < limit; ++i) selected.push_back(frames[ranked[i].second]);
+    return selected;
+}
+
+std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals) {
+    std::vector<Mat3> frames;
+    frames.reserve(normals.size());
+    const double pad = 2.0 * proxy.max_radius;
+    for (const Vec3& normal : normals) {
+        const Mat3 basis = frame_from_axis(normal);
+        std::vector<Eigen::Vector2d> projected;
+        projected.reserve(proxy.spheres.size());
+        for (const Sphere& s : proxy.spheres)
+            projected.emplace_back(s.center.dot(basis.col(1)), s.center.dot(basis.col(2)));
+        const std::vector<Eigen::Vector2d> hull = hull_2d(std::move(projected));
+        // Try each hull edge as a rectangle side; O(h^2) in the 2-D hull size, which stays small.
+        Eigen::Vector2d best_direction(1.0, 0.0);
+        double best_area = infinity;
+        for (std::size_t i = 0; i < hull.size(); ++i) {
+            const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
+            if (!(edge.norm() > 0.0)) continue;
+            const Eigen::Vector2d d = edge.normalized();
+            const Eigen::Vector2d perpendicular(-d.y(), d.x());
+            double low_d = infinity, high_d = -infinity, low_p = infinity, high_p = -infinity;
+            for (const Eigen::Vector2d& q : hull) {
+                low_d = std::min(low_d, q.dot(d)), high_d = std::max(high_d, q.dot(d));
+                low_p = std::min(low_p, q.dot(perpendicular)), high_p = std::max(high_p, q.dot(perpendicular));
+            }
+            const double area = (high_d - low_d + pad) * (high_p - low_p + pad);
+            if (area < best_area) best_area = area, best_direction = d;
+        }
+        Mat3 axes;
+        axes.col(0) = basis.col(0);
+        axes.col(1) = best_direction.x() * basis.col(1) + best_direction.y() * basis.col(2);
+        axes.col(2) = Vec3::Zero();
+        frames.push_back(proper_frame(axes));
+    }
+    return frames;
+}
+
 Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
     const Mat3 to_local = rotation.transpose();
     Vec3 low = Vec3::Constant(infinity);
@@ -181,19 +278,19 @@ Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
     return box;
 }
 
-double proxy_obb_volume(const PointProxy& proxy, const Mat3& rotation) {
+double proxy_obb_volume(const SphereProxy& proxy, const Mat3& rotation) {
     const Mat3 to_local = rotation.transpose();
     Vec3 low = Vec3::Constant(infinity);
     Vec3 high = Vec3::Constant(-infinity);
-    for (const Vec3& p : proxy.points) {
-        const Vec3 local = to_local * p;
-        low = low.cwiseMin(local);
-        high = high.cwiseMax(local);
+    for (const Sphere& s : proxy.spheres) {
+        const Vec3 local = to_local * s.center;
+        low = low.cwiseMin(local - Vec3::Constant(s.radius));
+        high = high.cwiseMax(local + Vec3::Constant(s.radius));
     }
-    return (high - low + Vec3::Constant(2.0 * proxy.max_radius)).prod();
+    return (high - low).prod();
 }
 
-Mat3 refine_frame(const PointProxy& proxy, const Mat3& rotation) {
+Mat3 refine_frame(const SphereProxy& proxy, const Mat3& rotation) {
     // Pattern search: try +-step about each box axis, keep any improvement, halve the step when none
     // helps. Start at ~6 degrees (candidate frames are usually close) and stop below ~0.01 degree.
     Mat3 best = rotation;

@@ -5,17 +5,32 @@
 #include <span>
 #include <vector>
 
+#include "convex_hull.hpp"
 #include "hbvh/geometry/obb.hpp"
 
 namespace hbvh::detail {
 
-/// A cheap stand-in for a sphere set when ranking many orientations: points whose every sphere lies
-/// within `max_radius` of their convex hull (hull vertices of the centres plus the largest radius).
-/// Extents measured on it are upper bounds, exact when all radii are equal.
-struct PointProxy {
-    std::vector<Vec3> points;
+/// The spheres that can touch the boundary of any convex volume around a set: those centred on a hull
+/// vertex, and every sphere of positive radius. A radius-0 point that is not a hull vertex lies in the
+/// hull of the others, so a convex volume containing them contains it too; dropping it changes no
+/// extent. Ranking orientations on this subset is therefore exact, yet costs O(hull size) for boxes.
+struct SphereProxy {
+    std::vector<Sphere> spheres;
+    std::vector<Vec3> hull_points;  ///< Centres of the hull vertices only: a cheaper, coarser stand-in.
     double max_radius = 0.0;
 };
+
+/// The proxy of `spheres`, whose centres' hull is `hull`.
+[[nodiscard]] SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull);
+
+/// How many hint frames reach the exact ranking; the rest are dropped by a coarse pre-ranking, so that a
+/// node over thousands of differently oriented boxes does not cost (boxes x spheres).
+inline constexpr std::size_t max_ranked_hints = 8;
+
+/// The (at most) `limit` hints, made proper, whose boxes around the hull points padded by the largest
+/// radius (an upper bound, O(hull size) each) are smallest. All of them, in order, when there are few.
+[[nodiscard]] std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> hints,
+                                             std::size_t limit = max_ranked_hints);
 
 /// `axes` made a proper rotation: columns orthonormalised in order (Gram-Schmidt), the last one
 /// completed by a cross product so that det = +1. A column of zero length is replaced by any perpendicular.
@@ -33,15 +48,22 @@ struct PointProxy {
 /// centres coincide.
 [[nodiscard]] std::vector<Mat3> dito_frames(std::span<const Sphere> spheres);
 
+/// For each unit `normals[i]`, the frame with column 0 along it whose cross-section is the smallest
+/// rectangle around the proxy's projected centres (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
+/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With face normals of the
+/// hull this gives O'Rourke's "one box face flush with a hull face" candidates.
+[[nodiscard]] std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals);
+
 /// The smallest box with axes `rotation` containing every sphere exactly (in double arithmetic:
 /// Obb::contains with zero tolerance holds for each input). O(n).
 [[nodiscard]] Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation);
 
-/// Volume of the box with axes `rotation` around `proxy` (an upper bound on obb_with_axes' volume).
-[[nodiscard]] double proxy_obb_volume(const PointProxy& proxy, const Mat3& rotation);
+/// Volume of the smallest box with axes `rotation` around the proxy's spheres (equal to obb_with_axes'
+/// volume on the full set, up to rounding).
+[[nodiscard]] double proxy_obb_volume(const SphereProxy& proxy, const Mat3& rotation);
 
 /// Deterministic local search (pattern search over small rotations about the frame's own axes, with
 /// halving step) that lowers proxy_obb_volume. Returns the improved frame; never a worse one.
-[[nodiscard]] Mat3 refine_frame(const PointProxy& proxy, const Mat3& rotation);
+[[nodiscard]] Mat3 refine_frame(const SphereProxy& proxy, const Mat3& rotation);
 
 }  // namespace hbvh::detail

@@ -10,19 +10,6 @@
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
-namespace {
-
-/// The hull vertices and largest radius: enough to rank orientations in O(hull size) each.
-detail::PointProxy make_proxy(std::span<const Sphere> spheres, const detail::HullSummary& hull) {
-    detail::PointProxy proxy;
-    proxy.points.reserve(hull.vertices.size());
-    for (std::uint32_t i : hull.vertices) proxy.points.push_back(spheres[i].center);
-    for (const Sphere& s : spheres) proxy.max_radius = std::max(proxy.max_radius, s.radius);
-    return proxy;
-}
-
-}  // namespace
-
 Obb fit_obb_covariance(std::span<const Sphere> spheres) {
     HBVH_ASSERT(!spheres.empty());
     // Gottschalk, Lin & Manocha 1996 (OBBTree, §4): the hull's surface covariance is insensitive to how
@@ -33,15 +20,20 @@ Obb fit_obb_covariance(std::span<const Sphere> spheres) {
 Obb fit_obb(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes) {
     HBVH_ASSERT(!spheres.empty());
     const detail::HullSummary hull = detail::summarize_hull(spheres);
-    const detail::PointProxy proxy = make_proxy(spheres, hull);
+    const detail::SphereProxy proxy = detail::make_proxy(spheres, hull);
     const Mat3 covariance_frame = detail::principal_frame(hull.covariance);
 
-    // Stage 1: rank every candidate orientation on the proxy (hull vertices), O(hull size) each, so that
-    // many hints stay cheap. World axes and the covariance frame are exact candidates in stage 3 anyway.
+    // Stage 1: rank every candidate orientation on the proxy (hull vertices and spheres of positive radius),
+    // O(proxy size) each, so that many hints stay cheap.
     std::vector<Mat3> candidates;
     candidates.reserve(hint_axes.size() + 24);
-    for (const Mat3& axes : hint_axes) candidates.push_back(detail::proper_frame(axes));
+    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) candidates.push_back(axes);
     for (const Mat3& axes : detail::dito_frames(spheres)) candidates.push_back(axes);
+    // Face-flush frames: along each large hull face normal and each covariance axis (for a flat set the
+    // smallest axis is the plane's normal, and the 2-D rectangle step then finds the best in-plane box).
+    std::vector<Vec3> normals = hull.face_normals;
+    for (int k = 0; k < 3; ++k) normals.push_back(covariance_frame.col(k));
+    for (const Mat3& axes : detail::face_flush_frames(proxy, normals)) candidates.push_back(axes);
     candidates.push_back(covariance_frame);
     candidates.push_back(Mat3::Identity());
     std::vector<std::pair<double, std::size_t>> ranked;

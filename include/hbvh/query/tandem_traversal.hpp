@@ -1,0 +1,92 @@
+// SPDX-License-Identifier: MIT
+// Collision queries between two posed hierarchies: tandem traversal and the two-level baseline.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+/// What a query reports.
+enum class CollideMode : std::uint8_t {
+    all,    ///< Every overlapping primitive pair.
+    first,  ///< Stop at the first overlapping primitive pair found.
+};
+
+/// Outcome of one query, with the work it took.
+struct CollideResult {
+    bool intersecting = false;
+    /// Overlapping pairs (primitive of a, primitive of b), as indices into each Bvh's input order, sorted.
+    /// In CollideMode::first it holds the one pair found (or nothing).
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
+    std::uint64_t bv_tests = 0;         ///< Overlap tests in which at least one volume is an inner node's.
+    std::uint64_t primitive_tests = 0;  ///< Overlap tests between two leaves (exact primitive geometry).
+    std::uint64_t nodes_visited = 0;    ///< Node pairs found overlapping and then expanded or reported.
+};
+
+/// One node of a QueryTree. Same indices as the Bvh it came from; everything in the Bvh's model frame.
+struct QueryNode {
+    BoundingVolume volume;           ///< The node's BV (for a leaf: its primitive's exact geometry).
+    Vec3 sphere_center;              ///< Centre of a sphere enclosing `volume` (the cheap pre-test).
+    double sphere_radius = 0.0;      ///< Its radius, padded by 1e-12 relative so containment survives rounding.
+    double measure = 0.0;            ///< volume(volume): the descent rule compares these.
+    std::uint32_t first_child = 0;   ///< Children: [first_child, first_child + child_count).
+    std::uint32_t child_count = 0;   ///< 0 for a leaf.
+    std::uint32_t primitive = 0;     ///< For a leaf: the primitive's index in input order.
+};
+
+/// The read-only layout queries run on, converted once from a Bvh (which stays the ground truth):
+/// flat node array, children contiguous, BVs in the model frame with their enclosing spheres and
+/// volumes precomputed, and the stack depth a traversal can need.
+class QueryTree {
+public:
+    /// Converts `bvh`. An empty Bvh gives an empty tree, which collides with nothing.
+    explicit QueryTree(const Bvh& bvh);
+
+    [[nodiscard]] bool empty() const { return nodes_.empty(); }
+    [[nodiscard]] std::span<const QueryNode> nodes() const { return nodes_; }
+    /// Leaf node index of each primitive, in input order.
+    [[nodiscard]] std::span<const std::uint32_t> primitive_nodes() const { return primitive_nodes_; }
+    /// Largest sum of child counts along a root-to-leaf path: this tree's share of the traversal stack.
+    [[nodiscard]] std::uint32_t stack_bound() const { return stack_bound_; }
+
+private:
+    std::vector<QueryNode> nodes_;
+    std::vector<std::uint32_t> primitive_nodes_;
+    std::uint32_t stack_bound_ = 0;
+};
+
+/// The pose of b's model frame relative to a's: maps b-model coordinates to a-model coordinates.
+/// Queries run in a's model frame, so this is the one transform a query computes.
+[[nodiscard]] RigidTransform relative_transform(const RigidTransform& pose_a, const RigidTransform& pose_b);
+
+/// Tandem traversal (Erleben et al. 2005): from the root pair, expand the node with the larger volume
+/// (or the inner one, if the other is a leaf) and test its children against the other node; leaf pairs
+/// are exact primitive tests. pose_a / pose_b map each tree's model frame to the world. No allocation
+/// except growing `result.pairs` (and a heap stack for trees deeper than the built-in 256 entries).
+/// `result` is overwritten; reusing it across queries keeps the pairs' capacity.
+void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
+             CollideMode mode, CollideResult& result);
+/// As above, returning a fresh result.
+[[nodiscard]] CollideResult collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
+                                    const RigidTransform& pose_b, CollideMode mode = CollideMode::all);
+/// Convenience for one-off queries: converts both Bvhs first (allocates; keep QueryTrees for many queries).
+[[nodiscard]] CollideResult collide(const Bvh& a, const RigidTransform& pose_a, const Bvh& b,
+                                    const RigidTransform& pose_b, CollideMode mode = CollideMode::all);
+
+/// The survey's Two-Level baseline: test the roots, and if they overlap test every primitive pair.
+/// Same frames, counters and results as collide().
+void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
+                       const RigidTransform& pose_b, CollideMode mode, CollideResult& result);
+/// As above, returning a fresh result.
+[[nodiscard]] CollideResult collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
+                                              const RigidTransform& pose_b, CollideMode mode = CollideMode::all);
+/// Convenience for one-off queries on Bvhs (allocates).
+[[nodiscard]] CollideResult collide_two_level(const Bvh& a, const RigidTransform& pose_a, const Bvh& b,
+                                              const RigidTransform& pose_b, CollideMode mode = CollideMode::all);
+
+}  // namespace hbvh

@@ -1,0 +1,224 @@
+// SPDX-License-Identifier: MIT
+// Tandem traversal and the two-level baseline against brute force, for every registered builder.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <functional>
+#include <string>
+
+#include "hbvh/assert.hpp"
+#include "hbvh/build/build.hpp"
+#include "hbvh/geometry/overlap.hpp"
+#include "hbvh/query/tandem_traversal.hpp"
+#include "hbvh/scene/generate.hpp"
+
+namespace hbvh {
+namespace {
+
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
+/// Every primitive pair tested with overlaps(), in a's model frame as the query defines it.
+Pairs brute_force(const Bvh& a, const RigidTransform& pose_a, const Bvh& b, const RigidTransform& pose_b) {
+    const RigidTransform t = relative_transform(pose_a, pose_b);
+    Pairs pairs;
+    for (std::uint32_t j = 0; j < b.primitives.size(); ++j) {
+        const BoundingVolume moved = transformed(b.primitives[j].volume, t);
+        for (std::uint32_t i = 0; i < a.primitives.size(); ++i)
+            if (overlaps(a.primitives[i].volume, moved)) pairs.emplace_back(i, j);
+    }
+    std::sort(pairs.begin(), pairs.end());
+    return pairs;
+}
+
+Vec3 scene_center(const Bvh& bvh) {
+    Aabb box = Aabb::empty();
+    for (const Primitive& p : bvh.primitives) box = box.merged(world_aabb(p.volume));
+    return box.center();
+}
+
+double scene_radius(const Bvh& bvh) {
+    Aabb box = Aabb::empty();
+    for (const Primitive& p : bvh.primitives) box = box.merged(world_aabb(p.volume));
+    return 0.5 * (box.max - box.min).norm();
+}
+
+/// A pose of b whose centre lands within `spread` x (radius of a) of a's centre, randomly rotated, so
+/// that the roots overlap most of the time and the scenes interpenetrate to varying depths.
+RigidTransform pose_near(const Bvh& a, const RigidTransform& pose_a, const Bvh& b, std::uint64_t seed, double spread) {
+    SplitMix64 rng(seed);
+    const RigidTransform spin{rng.rotation(), Vec3::Zero()};
+    const Vec3 offset = spread * scene_radius(a) * Vec3(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+    const RigidTransform to_origin{Mat3::Identity(), -scene_center(b)};
+    const RigidTransform to_target{Mat3::Identity(), pose_a.apply(scene_center(a)) + offset};
+    return to_target * spin * to_origin;
+}
+
+/// A containing BV of kind `kind` (0..3) around the spheres: exact-enough fits written here so that the
+/// traversal is tested on deep, heterogeneous trees whatever the registered builders produce.
+BoundingVolume containing_volume(const std::vector<Sphere>& spheres, int kind, SplitMix64& rng) {
+    Aabb box = Aabb::empty();
+    for (const Sphere& s : spheres) box = box.merged({s.center - Vec3::Constant(s.radius), s.center + Vec3::Constant(s.radius)});
+    const Vec3 m = box.center();
+    switch (kind) {
+        case 0: return box;
+        case 1: {
+            const Mat3 r = rng.rotation();
+            Vec3 lo = Vec3::Constant(1e300), hi = Vec3::Constant(-1e300);
+            for (const Sphere& s : spheres) {
+                const Vec3 local = r.transpose() * s.center;
+                lo = lo.cwiseMin(local - Vec3::Constant(s.radius));
+                hi = hi.cwiseMax(local + Vec3::Constant(s.radius));
+            }
+            return Obb{r * (0.5 * (lo + hi)), r, 0.5 * (hi - lo)};
+        }
+        case 2: {
+            double radius = 0.0;
+            for (const Sphere& s : spheres) radius = std::max(radius, (s.center - m).norm() + s.radius);
+            return Sphere{m, radius};
+        }
+        default: {
+            int axis = 0;
+            (box.max - box.min).maxCoeff(&axis);
+            const Vec3 u = Vec3::Unit(axis);
+            double t0 = 1e300, t1 = -1e300;
+            for (const Sphere& s : spheres) {
+                t0 = std::min(t0, (s.center - m).dot(u));
+                t1 = std::max(t1, (s.center - m).dot(u));
+            }
+            Capsule c{m + t0 * u, m + t1 * u, 0.0};
+            for (const Sphere& s : spheres) c.radius = std::max(c.radius, (s.center - c.closest_axis_point(s.center)).norm() + s.radius);
+            return c;
+        }
+    }
+}
+
+/// Test-only builder: binary or ternary median splits along the longest centroid axis, each inner node
+/// a random BV kind, padded by 1e-9 so that containment survives rounding.
+std::uint32_t add_subtree(TreeAssembler& assembler, std::span<const Primitive> primitives,
+                          std::vector<std::uint32_t> ids, SplitMix64& rng) {
+    if (ids.size() == 1) return assembler.add_leaf(ids.front());
+    Aabb spread = Aabb::empty();
+    std::vector<Sphere> spheres;
+    for (const std::uint32_t id : ids) {
+        const Vec3 c = world_aabb(primitives[id].volume).center();
+        spread = spread.merged({c, c});
+        append_generating_spheres(primitives[id].volume, spheres);
+    }
+    for (Sphere& s : spheres) s.radius += 1e-9;
+    int axis = 0;
+    (spread.max - spread.min).maxCoeff(&axis);
+    std::sort(ids.begin(), ids.end(), [&](std::uint32_t x, std::uint32_t y) {
+        return world_aabb(primitives[x].volume).center()[axis] < world_aabb(primitives[y].volume).center()[axis];
+    });
+    const std::size_t parts = ids.size() >= 6 && rng.uniform() < 0.3 ? 3 : 2;
+    std::vector<std::uint32_t> children;
+    for (std::size_t p = 0; p < parts; ++p) {
+        const std::size_t lo = p * ids.size() / parts, hi = (p + 1) * ids.size() / parts;
+        children.push_back(add_subtree(assembler, primitives, {ids.begin() + lo, ids.begin() + hi}, rng));
+    }
+    return assembler.add_group(children, containing_volume(spheres, static_cast<int>(rng.below(4)), rng));
+}
+
+Bvh build_deep_mixed(std::span<const Primitive> primitives, std::uint64_t seed) {
+    SplitMix64 rng(seed);
+    TreeAssembler assembler(primitives);
+    std::vector<std::uint32_t> ids(primitives.size());
+    for (std::uint32_t i = 0; i < ids.size(); ++i) ids[i] = i;
+    const std::uint32_t root = add_subtree(assembler, primitives, ids, rng);
+    return std::move(assembler).finish(root);
+}
+
+struct Case {
+    std::uint32_t count_a, count_b;
+    std::uint64_t seed;
+};
+
+/// One builder's trees over the shared cases: all, first and two-level against brute force.
+void check_builder(const std::string& name, const std::function<Bvh(std::span<const Primitive>, std::uint64_t)>& make) {
+    const std::array cases{Case{1, 1, 3}, Case{2, 5, 4}, Case{13, 13, 5}, Case{27, 27, 6}, Case{27, 9, 7}, Case{40, 40, 8}};
+    std::uint64_t queries = 0, intersecting = 0, root_overlaps = 0;
+    {
+        for (const Case& c : cases) {
+            const auto prims_a = generate_scene({.count = c.count_a, .seed = c.seed});
+            const auto prims_b = c.count_a == c.count_b ? prims_a : generate_scene({.count = c.count_b, .seed = c.seed + 100});
+            const Bvh a = make(prims_a, c.seed);
+            const Bvh b = make(prims_b, c.seed + 1);
+            const QueryTree qa(a), qb(b);
+            CollideResult reused;
+            for (std::uint64_t k = 0; k < 300; ++k) {
+                const RigidTransform pose_a = random_transform(1000 * c.seed + k, 10.0);
+                const RigidTransform pose_b = pose_near(a, pose_a, b, 7777 * c.seed + k, k % 3 == 0 ? 0.2 : 1.0);
+                const Pairs expected = brute_force(a, pose_a, b, pose_b);
+                const std::string where = name + " case " + std::to_string(c.seed) + " pose " + std::to_string(k);
+
+                collide(qa, pose_a, qb, pose_b, CollideMode::all, reused);
+                EXPECT_EQ(reused.pairs, expected) << where;
+                EXPECT_EQ(reused.intersecting, !expected.empty()) << where;
+                EXPECT_LE(reused.primitive_tests, std::uint64_t{c.count_a} * c.count_b) << where;
+
+                const CollideResult first = collide(qa, pose_a, qb, pose_b, CollideMode::first);
+                EXPECT_EQ(first.intersecting, !expected.empty()) << where;
+                EXPECT_EQ(first.pairs.size(), expected.empty() ? 0u : 1u) << where;
+                if (!first.pairs.empty()) {
+                    EXPECT_TRUE(std::binary_search(expected.begin(), expected.end(), first.pairs.front())) << where;
+                }
+
+                const CollideResult baseline = collide_two_level(qa, pose_a, qb, pose_b, CollideMode::all);
+                EXPECT_EQ(baseline.pairs, expected) << where;
+                const CollideResult baseline_first = collide_two_level(qa, pose_a, qb, pose_b, CollideMode::first);
+                EXPECT_EQ(baseline_first.intersecting, !expected.empty()) << where;
+
+                ++queries;
+                intersecting += expected.empty() ? 0 : 1;
+                root_overlaps += reused.nodes_visited > 0 ? 1 : 0;
+            }
+        }
+    }
+    // The poses must exercise the traversal: mostly overlapping roots, a mix of hits and misses.
+    EXPECT_GT(root_overlaps, queries * 3 / 4);
+    EXPECT_GT(intersecting, queries / 4);
+    EXPECT_LT(intersecting, queries);
+}
+
+TEST(TandemTraversal, MatchesBruteForceForEveryAlgorithm) {
+    for (const AlgorithmInfo& info : algorithms()) {
+        check_builder(std::string(info.name), [&](std::span<const Primitive> primitives, std::uint64_t) {
+            auto built = build(primitives, info.algorithm);
+            HBVH_ASSERT(built.has_value());
+            return std::move(built).value();
+        });
+    }
+}
+
+TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
+    check_builder("deep-mixed", build_deep_mixed);
+}
+
+TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {
+    const auto prims = generate_scene({.count = 13, .seed = 21});
+    const Bvh bvh = build(prims, algorithms().front().algorithm).value();
+    const RigidTransform pose = RigidTransform::identity();
+    // Identical poses: every primitive touches at least itself.
+    const CollideResult r = collide(bvh, pose, bvh, pose, CollideMode::all);
+    EXPECT_TRUE(r.intersecting);
+    for (std::uint32_t i = 0; i < prims.size(); ++i)
+        EXPECT_TRUE(std::binary_search(r.pairs.begin(), r.pairs.end(), std::pair{i, i}));
+    EXPECT_EQ(r.pairs, collide_two_level(bvh, pose, bvh, pose, CollideMode::all).pairs);
+    const Bvh empty;
+    EXPECT_FALSE(collide(empty, pose, bvh, pose).intersecting);
+    EXPECT_FALSE(collide_two_level(bvh, pose, empty, pose).intersecting);
+}
+
+TEST(TandemTraversal, StackBoundCoversTwoLevelFanOut) {
+    // A two-level tree over 300 primitives needs a stack beyond the built-in 256 entries.
+    const auto prims = generate_scene({.count = 300, .seed = 5});
+    const Bvh bvh = build(prims, Algorithm::two_level).value();
+    const QueryTree tree(bvh);
+    EXPECT_EQ(tree.stack_bound(), 300u);
+    const RigidTransform pose = RigidTransform::identity();
+    const CollideResult r = collide(tree, pose, tree, pose, CollideMode::all);
+    EXPECT_EQ(r.pairs, brute_force(bvh, pose, bvh, pose));
+}
+
+}  // namespace
+}  // namespace hbvh
