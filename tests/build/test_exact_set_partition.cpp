@@ -224,6 +224,37 @@ TEST(ExactSetPartition, BudgetStopsWithBestFoundAndValidLowerBound) {
     EXPECT_LE(timed->lower_bound, full->cost + 1e-9);
 }
 
+TEST(ExactSetPartition, EqualsReferenceSolverWhereEq7Holds) {
+    // Instances shaped like real levels: node volumes v_j, candidate cost = |c| x (a volume at least the
+    // members' total), so every cost is >= 2 x its members' volume and the survey's Eq. 7 bound is valid.
+    SplitMix64 rng(777);
+    for (int trial = 0; trial < 500; ++trial) {
+        const std::uint32_t n = 2 + static_cast<std::uint32_t>(rng.below(11));
+        std::vector<double> volumes(n);
+        for (double& v : volumes) v = rng.uniform(0.5, 2.0);
+        std::vector<Candidate> candidates;
+        const std::uint32_t count = 1 + static_cast<std::uint32_t>(rng.below(3 * n));
+        for (std::uint32_t i = 0; i < count; ++i) {
+            const std::uint32_t size = 2 + static_cast<std::uint32_t>(rng.below(std::min(n - 1, 4u)));
+            std::vector<std::uint32_t> m;
+            while (m.size() < size) {
+                const auto j = static_cast<std::uint32_t>(rng.below(n));
+                if (std::find(m.begin(), m.end(), j) == m.end()) m.push_back(j);
+            }
+            std::sort(m.begin(), m.end());
+            double total = 0.0;
+            for (std::uint32_t j : m) total += volumes[j];
+            candidates.push_back({m, static_cast<double>(size) * total * rng.uniform(1.0, 1.6)});
+        }
+        const auto exact = solve_exact(n, candidates);
+        const auto reference = solve_reference_branch_and_bound(n, candidates, volumes);
+        ASSERT_EQ(exact.has_value(), reference.has_value()) << "trial " << trial;
+        if (!exact) continue;
+        EXPECT_FALSE(reference->budget_hit);
+        EXPECT_NEAR(exact->cost, reference->cost, 1e-9) << "trial " << trial;
+    }
+}
+
 TEST(ExactSetPartition, Deterministic) {
     const auto candidates = window_instance(80, 3);
     const auto a = solve_exact(80, candidates);
