@@ -169,13 +169,40 @@ Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_
     const std::size_t keep = std::min<std::size_t>(3, ranked.size());
     std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
 
-    // Stage 3: exact capsules (minimum enclosing circle, radius search) for the principal axis of the
-    // centres and the best-ranked directions; keep the smallest.
-    Capsule best = capsule_along(spheres, detail::frame_from_axis(point_frame.col(0)), true);
+    // Stage 3: full capsules (minimum enclosing circle, radius search) for the principal axis of the
+    // centres and the best-ranked directions. The proxy gives the same capsule as the whole set (the
+    // dropped points lie in the hull of the kept ones), for less work.
+    std::span<const Sphere> kept = proxy.spheres;
+    Vec3 best_direction = point_frame.col(0);
+    Capsule best = capsule_along(kept, detail::frame_from_axis(best_direction), true);
     for (std::size_t i = 0; i < keep; ++i) {
-        Capsule candidate = capsule_along(spheres, detail::frame_from_axis(directions[ranked[i].second]), true);
-        if (candidate.volume() < best.volume()) best = candidate;
+        const Vec3& direction = directions[ranked[i].second];
+        Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true);
+        if (candidate.volume() < best.volume()) best = candidate, best_direction = direction;
     }
+
+    // Stage 4: polish the winning direction by tilting it about two perpendicular axes (pattern search
+    // with halving step, as for the OBB frame), evaluating full capsules.
+    double step = 0.05;
+    int evaluations = 0;
+    while (step > 1e-3 && evaluations < 32) {
+        bool improved = false;
+        const Mat3 frame = detail::frame_from_axis(best_direction);
+        for (int axis = 1; axis <= 2; ++axis)
+            for (double sign : {1.0, -1.0}) {
+                const Vec3 direction = Eigen::AngleAxisd(sign * step, frame.col(axis)) * best_direction;
+                Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true);
+                ++evaluations;
+                if (candidate.volume() < best.volume() * (1.0 - 1e-12))
+                    best = candidate, best_direction = direction, improved = true;
+            }
+        if (!improved) step *= 0.5;
+    }
+
+    // The minimum enclosing sphere is a capsule of length zero; with it as a candidate a capsule is never
+    // worse than the sphere fitter.
+    const Sphere sphere = fit_sphere(spheres);
+    if (sphere.volume() < best.volume()) best = Capsule{sphere.center, sphere.center, sphere.radius};
     make_containing(best, spheres);
     return best;
 }

@@ -50,8 +50,9 @@ inline constexpr std::size_t max_ranked_hints = 8;
 
 /// For each unit `normals[i]`, the frame with column 0 along it whose cross-section is the smallest
 /// rectangle around the proxy's projected centres (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
-/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With face normals of the
-/// hull this gives O'Rourke's "one box face flush with a hull face" candidates.
+/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With the hull's face
+/// normals this gives boxes with a face flush with a hull face: a heuristic in the spirit of O'Rourke
+/// 1985 (whose minimal box has two adjacent faces each containing a hull edge), not a guarantee.
 [[nodiscard]] std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals);
 
 /// The smallest box with axes `rotation` containing every sphere exactly (in double arithmetic:

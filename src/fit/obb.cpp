@@ -10,6 +10,7 @@
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
+
 Obb fit_obb_covariance(std::span<const Sphere> spheres) {
     HBVH_ASSERT(!spheres.empty());
     // Gottschalk, Lin & Manocha 1996 (OBBTree, §4): the hull's surface covariance is insensitive to how

@@ -7,6 +7,7 @@
 #include <numbers>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <Eigen/LU>
@@ -176,6 +177,18 @@ TEST(Fit, ObbIsNoLargerThanAabbOrCovarianceBoxAndProper) {
     }
 }
 
+TEST(Fit, CapsuleIsNoLargerThanSphere) {
+    // The minimum sphere is a zero-length capsule and one of fit_capsule's candidates. Allow for the
+    // capsule's rounding pad, a few ulps of the coordinates' magnitude.
+    for (const SphereSet& set : all_sets()) {
+        const Sphere sphere = fit_sphere(set.spheres);
+        const Aabb aabb = fit_aabb(set.spheres);
+        const double magnitude = std::max(aabb.min.cwiseAbs().maxCoeff(), aabb.max.cwiseAbs().maxCoeff());
+        const Sphere allowance{sphere.center, sphere.radius + 8.0 * 0x1.0p-52 * magnitude};
+        EXPECT_LE(fit_capsule(set.spheres, set.hints).volume(), allowance.volume() * (1.0 + 1e-12)) << set.name;
+    }
+}
+
 TEST(Fit, FitDispatchMatchesKindFitters) {
     const SphereSet set = random_sets()[7];
     EXPECT_EQ(volume(fit(BvType::sphere, set.spheres)), fit_sphere(set.spheres).volume());
@@ -318,6 +331,29 @@ TEST(Fit, CapsuleBeatsSphereOnLongThinSets) {
     const Capsule fitted = fit_capsule(spheres);
     EXPECT_LT(fitted.volume(), 0.05 * fit_sphere(spheres).volume());
     EXPECT_GT(std::abs(fitted.direction().x()), 0.99);
+}
+
+TEST(Fit, FittersAreDeterministicAndThreadSafe) {
+    // Builders may fit nodes in parallel: qhull runs on a per-call state (libqhull_r), CGAL on locals.
+    std::vector<SphereSet> sets;
+    const std::vector<SphereSet> all = all_sets();
+    for (std::size_t i = 0; i < all.size(); i += 4) sets.push_back(all[i]);  // a quarter keeps it quick
+    auto fit_all = [&](std::vector<double>& volumes) {
+        for (const SphereSet& set : sets) {
+            volumes.push_back(fit_obb(set.spheres, set.hints).volume());
+            volumes.push_back(fit_capsule(set.spheres, set.hints).volume());
+            volumes.push_back(fit_sphere(set.spheres).volume());
+        }
+    };
+    std::vector<double> serial;
+    fit_all(serial);
+    std::vector<double> first;
+    std::vector<double> second;
+    std::thread worker([&] { fit_all(first); });
+    fit_all(second);
+    worker.join();
+    EXPECT_EQ(first, serial);
+    EXPECT_EQ(second, serial);
 }
 
 TEST(Fit, LargeSetStaysFast) {

@@ -1,0 +1,114 @@
+// SPDX-License-Identifier: MIT
+// read_text_file and write_file_atomic: contents, errors that name the file, nothing left behind.
+#include "hbvh/io/file.hpp"
+
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace hbvh {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A fresh empty directory per test, removed afterwards.
+class FileTest : public testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = testing::UnitTest::GetInstance()->current_test_info();
+        directory_ = fs::temp_directory_path() / ("hbvh_io_test_" + std::to_string(::getpid()) + "_" + info->name());
+        fs::remove_all(directory_);
+        fs::create_directories(directory_);
+    }
+    void TearDown() override { fs::remove_all(directory_); }
+
+    /// Names in the directory, to check that no temporary file is left over.
+    [[nodiscard]] std::vector<std::string> entries() const {
+        std::vector<std::string> names;
+        for (const auto& entry : fs::directory_iterator(directory_)) names.push_back(entry.path().filename().string());
+        std::sort(names.begin(), names.end());
+        return names;
+    }
+
+    fs::path directory_;
+};
+
+TEST_F(FileTest, WriteThenReadGivesTheSameBytes) {
+    std::string content = "line 1\r\nline 2\n";
+    content += '\0';
+    content += "\xFF after a zero byte";
+    const fs::path path = directory_ / "out.xml";
+    ASSERT_TRUE(write_file_atomic(path, content));
+    const Result<std::string> read = read_text_file(path);
+    ASSERT_TRUE(read) << read.error().to_string();
+    EXPECT_EQ(*read, content);
+    EXPECT_EQ(entries(), std::vector<std::string>{"out.xml"});
+}
+
+TEST_F(FileTest, ReplacesAnExistingFileAndKeepsItsPermissions) {
+    const fs::path path = directory_ / "out.xml";
+    std::ofstream(path) << "old content that is longer than the new";
+    ::chmod(path.c_str(), 0640);
+    ASSERT_TRUE(write_file_atomic(path, "new"));
+    EXPECT_EQ(*read_text_file(path), "new");
+    struct stat info {};
+    ASSERT_EQ(::stat(path.c_str(), &info), 0);
+    EXPECT_EQ(info.st_mode & 0777, 0640u);
+    EXPECT_EQ(entries(), std::vector<std::string>{"out.xml"});
+}
+
+TEST_F(FileTest, EmptyContentMakesAnEmptyFile) {
+    const fs::path path = directory_ / "empty";
+    ASSERT_TRUE(write_file_atomic(path, ""));
+    EXPECT_EQ(*read_text_file(path), "");
+}
+
+TEST_F(FileTest, FailureLeavesNothingBehind) {
+    // The target is a directory: rename() refuses, and the temporary file must be gone again.
+    const fs::path target = directory_ / "taken";
+    fs::create_directory(target);
+    const Status status = write_file_atomic(target, "content");
+    ASSERT_FALSE(status);
+    EXPECT_EQ(status.error().file, target.string());
+    EXPECT_NE(status.error().message.find("cannot replace"), std::string::npos) << status.error().to_string();
+    EXPECT_EQ(entries(), std::vector<std::string>{"taken"});
+    EXPECT_TRUE(fs::is_empty(target));
+}
+
+TEST_F(FileTest, MissingDirectoryIsAnError) {
+    const fs::path path = directory_ / "no" / "such" / "dir" / "out.xml";
+    const Status status = write_file_atomic(path, "x");
+    ASSERT_FALSE(status);
+    EXPECT_EQ(status.error().file, path.string());
+    EXPECT_NE(status.error().message.find("No such file or directory"), std::string::npos) << status.error().to_string();
+    EXPECT_TRUE(entries().empty());
+}
+
+TEST_F(FileTest, ReadErrorsNameTheFile) {
+    const fs::path missing = directory_ / "missing.xml";
+    const Result<std::string> not_there = read_text_file(missing);
+    ASSERT_FALSE(not_there);
+    EXPECT_EQ(not_there.error().file, missing.string());
+    EXPECT_EQ(not_there.error().line, 0);
+    EXPECT_NE(not_there.error().message.find("No such file or directory"), std::string::npos);
+
+    const Result<std::string> directory = read_text_file(directory_);
+    ASSERT_FALSE(directory);
+    EXPECT_NE(directory.error().message.find("directory"), std::string::npos);
+}
+
+TEST_F(FileTest, ReadsAFileLargerThanOneChunk) {
+    const std::string content(300000, 'x');
+    const fs::path path = directory_ / "big";
+    ASSERT_TRUE(write_file_atomic(path, content));
+    EXPECT_EQ(read_text_file(path)->size(), content.size());
+}
+
+}  // namespace
+}  // namespace hbvh
