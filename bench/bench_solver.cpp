@@ -2,21 +2,23 @@
 // solve_exact vs the survey's reference branch and bound on the level instances of a Tie-Interceptor-size
 // model (27 primitives), and the optimal builder's subset DP at 13/15/17 primitives.
 //
-// Until data/models/tie_interceptor.xml and the bnb branch's Enlarge generator are on this branch, the
-// model is a generated 27-primitive scene (fixed seed) and candidates come from a local Enlarge-style
-// generator (survey §3, Figure 11): grow each node's world AABB by 5 % steps until it touches `want`
-// others, then every subset of the node and those others with 2..lg(n) members.
+// The level instances are those B&B-Enlarge's driver produces on data/models/tie_interceptor.xml (a
+// generated 27-primitive scene with a fixed seed if the file is missing).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <optional>
 
+#include "hbvh/build/bottom_up.hpp"
+#include "hbvh/build/candidates.hpp"
 #include "hbvh/build/optimal.hpp"
 #include "hbvh/build/set_partition.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
 
 namespace hbvh {
@@ -28,89 +30,27 @@ struct LevelInstance {
     std::vector<double> node_volumes;
 };
 
-bool touches(const Aabb& a, const Aabb& b) {
-    return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+/// The model: data/models/tie_interceptor.xml (27 primitives), or a generated 27-primitive scene if absent.
+std::vector<Primitive> tie_model() {
+    const Result<XmlModel> model = read_xml_file(std::filesystem::path(HBVH_SOURCE_DIR) / "data/models/tie_interceptor.xml");
+    if (model.has_value()) return model->primitives;
+    return generate_scene({.count = 27, .seed = 27});
 }
 
-/// Enlarge-style candidates for one level; `groups[j]` = primitives under node j.
-std::vector<Candidate> enlarge_candidates(const std::vector<Primitive>& primitives,
-                                          const std::vector<std::vector<std::uint32_t>>& groups,
-                                          const VolumePolicy& policy, std::uint32_t want) {
-    const auto n = static_cast<std::uint32_t>(groups.size());
-    std::vector<Aabb> boxes(n);
-    for (std::uint32_t j = 0; j < n; ++j) {
-        Aabb box = Aabb::empty();
-        for (std::uint32_t p : groups[j]) box = box.merged(world_aabb(primitives[p].volume));
-        boxes[j] = box;
-    }
-    const std::uint32_t max_size = std::max(2u, static_cast<std::uint32_t>(std::floor(std::log2(n))));
-    std::vector<std::vector<std::uint32_t>> member_sets;
-    for (std::uint32_t a = 0; a < n; ++a) {
-        std::vector<std::uint32_t> hits;
-        for (double scale = 1.05; hits.size() < std::min(want, n - 1); scale *= 1.05) {
-            const Vec3 c = boxes[a].center();
-            const Vec3 h = boxes[a].half_extents() * scale + Vec3::Constant(1e-9 * scale);
-            const Aabb grown{c - h, c + h};
-            hits.clear();
-            for (std::uint32_t b = 0; b < n; ++b)
-                if (b != a && touches(grown, boxes[b])) hits.push_back(b);
-        }
-        const auto k = static_cast<std::uint32_t>(std::min<std::size_t>(hits.size(), 12));
-        for (std::uint32_t pick = 1; pick < (1u << k); ++pick) {
-            if (static_cast<std::uint32_t>(std::popcount(pick)) + 1 > max_size) continue;
-            std::vector<std::uint32_t> m{a};
-            for (std::uint32_t i = 0; i < k; ++i)
-                if (pick >> i & 1u) m.push_back(hits[i]);
-            std::sort(m.begin(), m.end());
-            member_sets.push_back(std::move(m));
-        }
-    }
-    std::sort(member_sets.begin(), member_sets.end());
-    member_sets.erase(std::unique(member_sets.begin(), member_sets.end()), member_sets.end());
-    std::vector<Candidate> candidates;
-    for (auto& m : member_sets) {
-        FitInput input;
-        for (std::uint32_t j : m)
-            for (std::uint32_t p : groups[j]) input.add(primitives[p].volume);
-        const double cost = static_cast<double>(m.size()) * policy.weighted_volume(fit_best(input.spheres, policy, input.hint_axes));
-        candidates.push_back({std::move(m), cost});
-    }
-    return candidates;
-}
-
-/// Runs the bottom-up levels with solve_exact and records every level's instance.
+/// Runs B&B-Enlarge's levels (library Enlarge generator, bottom-up driver) with solve_exact and records
+/// every level's instance exactly as the driver hands it to the solver.
 const std::vector<LevelInstance>& tie_levels() {
     static const std::vector<LevelInstance> levels = [] {
-        const VolumePolicy policy = VolumePolicy::all();
-        const auto primitives = generate_scene({.count = 27, .seed = 27});
-        std::vector<std::vector<std::uint32_t>> groups;
-        for (std::uint32_t i = 0; i < primitives.size(); ++i) groups.push_back({i});
         std::vector<LevelInstance> out;
-        while (groups.size() > 1) {
-            LevelInstance level;
-            level.node_count = static_cast<std::uint32_t>(groups.size());
-            level.candidates = enlarge_candidates(primitives, groups, policy, 3);
-            for (const auto& g : groups) {
-                FitInput input;
-                for (std::uint32_t p : g) input.add(primitives[p].volume);
-                level.node_volumes.push_back(policy.weighted_volume(fit_best(input.spheres, policy, input.hint_axes)));
-            }
-            std::optional<Partition> p = solve_exact(level.node_count, level.candidates);
-            if (!p) {
-                // No exact cover among the candidates: carry each node up alone (cost of a lone child).
-                for (std::uint32_t j = 0; j < level.node_count; ++j) level.candidates.push_back({{j}, 2.0 * level.node_volumes[j]});
-                p = solve_exact(level.node_count, level.candidates);
-            }
-            std::vector<std::vector<std::uint32_t>> next;
-            for (std::uint32_t c : p->chosen) {
-                std::vector<std::uint32_t> merged;
-                for (std::uint32_t j : level.candidates[c].members) merged.insert(merged.end(), groups[j].begin(), groups[j].end());
-                next.push_back(std::move(merged));
-            }
-            out.push_back(std::move(level));
-            if (next.size() == groups.size()) break;  // no progress possible
-            groups = std::move(next);
-        }
+        const auto primitives = tie_model();
+        const LevelSolver recording = [&out](std::uint32_t node_count, std::span<const Candidate> candidates,
+                                             std::span<const double> node_volumes, const SolverBudget& budget) {
+            out.push_back({node_count, {candidates.begin(), candidates.end()}, {node_volumes.begin(), node_volumes.end()}});
+            return solve_exact(node_count, candidates, budget);
+        };
+        const Bvh bvh = build_bottom_up(primitives, VolumePolicy::all(),
+                                        [](const Level& level) { return enlarge_candidates(level); }, recording);
+        benchmark::DoNotOptimize(bvh);
         return out;
     }();
     return levels;
@@ -145,7 +85,7 @@ void BM_solve_exact_level(benchmark::State& state) {
     for (auto _ : state) benchmark::DoNotOptimize(solve_exact(level.node_count, level.candidates));
     state.counters["nodes"] = level.node_count;
 }
-BENCHMARK(BM_solve_exact_level)->DenseRange(0, 3)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_solve_exact_level)->DenseRange(0, 5)->Unit(benchmark::kMillisecond);
 
 void BM_solve_reference_level(benchmark::State& state) {
     const auto& levels = tie_levels();
@@ -165,7 +105,7 @@ void BM_solve_reference_level(benchmark::State& state) {
     state.counters["nodes"] = level.node_count;
     state.counters["budget_hit"] = budget_hit ? 1.0 : 0.0;
 }
-BENCHMARK(BM_solve_reference_level)->DenseRange(0, 3)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(BM_solve_reference_level)->DenseRange(0, 5)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 /// Per-level comparison printed once: candidates, costs of both solvers, solver nodes.
 void BM_level_table(benchmark::State& state) {

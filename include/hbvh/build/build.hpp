@@ -7,6 +7,8 @@
 #include <span>
 #include <string_view>
 
+#include "hbvh/build/bnb_exact.hpp"
+#include "hbvh/build/branch_and_bound.hpp"
 #include "hbvh/build/optimal.hpp"
 #include "hbvh/build/report.hpp"
 #include "hbvh/fit/volume_policy.hpp"
@@ -17,7 +19,10 @@ namespace hbvh {
 
 enum class Algorithm {
     two_level,
+    bnb_tightest,
+    bnb_enlarge,
     optimal,
+    bnb_exact,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -36,7 +41,9 @@ struct AlgorithmInfo {
 struct BuildOptions {
     VolumePolicy policy;
     BuildReport* report = nullptr;  ///< Filled when non-null.
+    BranchAndBoundOptions branch_and_bound;  ///< bnb-tightest, bnb-enlarge.
     OptimalOptions optimal;         ///< For Algorithm::optimal.
+    ExactBottomUpOptions bnb_exact;  ///< For Algorithm::bnb_exact.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
