@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <optional>
 
+#include "hbvh/build/bnb_exact.hpp"
 #include "hbvh/build/bottom_up.hpp"
 #include "hbvh/build/candidates.hpp"
 #include "hbvh/build/optimal.hpp"
@@ -20,6 +21,7 @@
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
 namespace {
@@ -122,6 +124,21 @@ void BM_level_table(benchmark::State& state) {
     }
 }
 BENCHMARK(BM_level_table)->Iterations(1);
+
+/// bnb-exact's rich candidates + exact solver alone (no bnb-enlarge guarantee) vs bnb-enlarge on the model.
+void BM_rich_vs_enlarge(benchmark::State& state) {
+    const auto primitives = tie_model();
+    for (auto _ : state) {
+        ExactBottomUpOptions alone;
+        alone.guarantee_enlarge = false;
+        const double rich = cost(build_bnb_exact(primitives, VolumePolicy::all(), alone));
+        const double enlarge = cost(build_bnb_enlarge(primitives, VolumePolicy::all()));
+        state.counters["rich_cost"] = rich;
+        state.counters["enlarge_cost"] = enlarge;
+        state.counters["ratio"] = rich / enlarge;
+    }
+}
+BENCHMARK(BM_rich_vs_enlarge)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 /// The optimal builder's DP alone, on a synthetic AABB-like volume function (fitting excluded).
 void BM_optimal_dp(benchmark::State& state) {

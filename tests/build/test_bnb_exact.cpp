@@ -27,18 +27,12 @@ void expect_no_worse_than_enlarge(const std::vector<Primitive>& primitives, cons
     EXPECT_LE(cost(*exact), cost(*enlarge)) << what;
     EXPECT_FALSE(report.levels.empty()) << what;
 
-    // Without the guarantee: report how the rich candidates alone compare (informative, not asserted).
-    ExactBottomUpOptions alone;
-    alone.guarantee_enlarge = false;
-    const Bvh rich = build_bnb_exact(primitives, options.policy, alone);
-    EXPECT_TRUE(validate(rich).has_value()) << what;
-    ::testing::Test::RecordProperty(what + "_rich_over_enlarge", std::to_string(cost(rich) / cost(*enlarge)));
 }
 
 TEST(BnbExact, IsRegistered) { EXPECT_EQ(parse_algorithm("bnb-exact"), Algorithm::bnb_exact); }
 
 TEST(BnbExact, NoWorseThanEnlargeOnGeneratedScenes) {
-    for (std::uint32_t count : {9u, 20u}) {
+    for (std::uint32_t count : {9u, 16u}) {
         SceneOptions scene;
         scene.count = count;
         scene.seed = 100 + count;
