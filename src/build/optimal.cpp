@@ -23,6 +23,7 @@
 #include <string>
 
 #include "hbvh/assert.hpp"
+#include "hbvh/build/bnb_exact.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
@@ -138,6 +139,16 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePol
     const auto start = std::chrono::steady_clock::now();
     const std::uint32_t limit = std::min(options.max_primitives, optimal_hard_limit);
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
+    if (primitives.size() > limit && options.fall_back) {
+        // Documented refusal of the DP, but a tree all the same (docs/solver.md §2).
+        Bvh fallback = build_bnb_exact(primitives, policy, {}, report);
+        if (report != nullptr) {
+            report->lower_bound = 0.0;
+            report->notes.push_back("optimal: " + std::to_string(primitives.size()) + " primitives exceed the limit of " +
+                                    std::to_string(limit) + "; built bnb-exact instead (not proven optimal)");
+        }
+        return fallback;
+    }
     if (primitives.size() > limit)
         return Error{"the optimal builder handles at most " + std::to_string(limit) + " primitives, got " +
                      std::to_string(primitives.size()) + " (its subset DP is exponential; see docs/solver.md)"};

@@ -156,11 +156,18 @@ TEST(OptimalHierarchy, NoWorseThanAnyRegisteredBuilder) {
     }
 }
 
-TEST(OptimalHierarchy, RefusesAboveTheLimitAndHandlesOnePrimitive) {
+TEST(OptimalHierarchy, RefusesOrFallsBackAboveTheLimitAndHandlesOnePrimitive) {
     const auto many = generate_scene({.count = 19, .seed = 1});
-    const Result<Bvh> refused = build_optimal(many, VolumePolicy::all());
+    const Result<Bvh> refused = build_optimal(many, VolumePolicy::all(), {.max_primitives = 18, .fall_back = false});
     ASSERT_FALSE(refused.has_value());
     EXPECT_NE(refused.error().message.find("at most 18"), std::string::npos);
+    const auto few = generate_scene({.count = 6, .seed = 1});
+    BuildReport report;
+    const Result<Bvh> fallback = build_optimal(few, VolumePolicy::all(), {.max_primitives = 4}, &report);
+    ASSERT_TRUE(fallback.has_value());  // fall_back: bnb-exact's tree, noted in the report
+    EXPECT_TRUE(validate(*fallback).has_value());
+    EXPECT_EQ(report.lower_bound, 0.0);
+    EXPECT_FALSE(report.notes.empty());
     EXPECT_FALSE(build_optimal(std::span<const Primitive>{}, VolumePolicy::all()).has_value());
     const auto one = generate_scene({.count = 1, .seed = 1});
     const Result<Bvh> leaf = build_optimal(one, VolumePolicy::all());

@@ -23,6 +23,10 @@ struct OptimalOptions {
     /// Refuse (return an Error) above this many primitives; clamped to optimal_hard_limit.
     /// 18 builds in seconds with AABB/sphere and in tens of seconds with every kind (OBB fits dominate).
     std::uint32_t max_primitives = 18;
+    /// Above max_primitives: true builds bnb-exact's tree instead (noted in the report, lower bound 0, so
+    /// every registered builder works at any size, as the shared property suites expect); false returns
+    /// an Error that names the limit.
+    bool fall_back = true;
 };
 
 /// One inner node of an optimal hierarchy: the primitives it covers and its children's, as bit masks
@@ -49,8 +53,8 @@ struct OptimalPlan {
 /// The optimal hierarchy over `primitives`: optimal over all trees whose inner-node BVs are
 /// fit_best(covered primitives) under `policy` (fitting input as FitInput over the covered primitives in
 /// input order, as build_two_level does). Subset volumes are fitted in parallel with TBB; the result does
-/// not depend on the thread count. Error when there are no primitives or more than
-/// options.max_primitives. `report`, when non-null, gets one level entry and the proven optimum as lower
+/// not depend on the thread count. Error when there are no primitives, or more than
+/// options.max_primitives with fall_back off (with it on: bnb-exact's tree, not proven optimal). `report`, when non-null, gets one level entry and the proven optimum as lower
 /// bound.
 [[nodiscard]] Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePolicy& policy,
                                         const OptimalOptions& options = {}, BuildReport* report = nullptr);
