@@ -17,6 +17,8 @@ int main(int argc, char** argv) {
     add_stats_command(app, command);
     add_generate_command(app, command);
     add_compare_command(app, command);
+    add_collide_command(app, command);
+    add_simulate_command(app, command);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

@@ -1,5 +1,5 @@
 // SPDX-License-Identifier: MIT
-// Candidate orientations (principal axes, DiTO frames, local refinement) and per-frame box evaluation.
+// Candidate orientations (principal axes, DiTO, face-flush, local refinement) and per-frame box evaluation.
 #include "frames.hpp"
 
 #include <algorithm>
@@ -73,7 +73,8 @@ Mat3 proper_frame(const Mat3& axes) {
     x = x.norm() > 0.0 ? Vec3(x.normalized()) : Vec3::UnitX();
     Vec3 y = axes.col(1) - axes.col(1).dot(x) * x;
     // A column that is (nearly) parallel to the first carries no orientation; pick any perpendicular.
-    y = y.norm() > 1e-12 * std::max(1.0, axes.col(1).norm()) ? Vec3(y.normalized()) : any_perpendicular(x);
+    // The test is relative: callers pass unnormalised cross products, tiny for tiny inputs.
+    y = y.norm() > 1e-12 * axes.col(1).norm() ? Vec3(y.normalized()) : any_perpendicular(x);
     Mat3 frame;
     frame.col(0) = x;
     frame.col(1) = y;
@@ -228,9 +229,10 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
         std::vector<Eigen::Vector2d> projected;
-        projected.reserve(proxy.spheres.size());
-        for (const Sphere& s : proxy.spheres)
-            projected.emplace_back(s.center.dot(basis.col(1)), s.center.dot(basis.col(2)));
+        // Every centre lies in the hull of the hull-vertex centres, so their projections span the same
+        // 2-D hull: sorting only those keeps this O(hull size) per normal even when many spheres are kept.
+        projected.reserve(proxy.hull_points.size());
+        for (const Vec3& p : proxy.hull_points) projected.emplace_back(p.dot(basis.col(1)), p.dot(basis.col(2)));
         const std::vector<Eigen::Vector2d> hull = hull_2d(std::move(projected));
         // Try each hull edge as a rectangle side; O(h^2) in the 2-D hull size, which stays small.
         Eigen::Vector2d best_direction(1.0, 0.0);

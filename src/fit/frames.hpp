@@ -49,7 +49,7 @@ inline constexpr std::size_t max_ranked_hints = 8;
 [[nodiscard]] std::vector<Mat3> dito_frames(std::span<const Sphere> spheres);
 
 /// For each unit `normals[i]`, the frame with column 0 along it whose cross-section is the smallest
-/// rectangle around the proxy's projected centres (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
+/// rectangle around the projected hull points (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
 /// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With the hull's face
 /// normals this gives boxes with a face flush with a hull face: a heuristic in the spirit of O'Rourke
 /// 1985 (whose minimal box has two adjacent faces each containing a hull edge), not a guarantee.

@@ -333,6 +333,25 @@ TEST(Fit, CapsuleBeatsSphereOnLongThinSets) {
     EXPECT_GT(std::abs(fitted.direction().x()), 0.99);
 }
 
+TEST(Fit, FittersAreScaleInvariant) {
+    // Scaling by a power of two is exact in floating point, so a fitter without absolute thresholds
+    // returns the same volumes times the cube of the scale. Catches tolerances that are not relative.
+    const std::vector<SphereSet> all = random_sets();
+    for (std::size_t i = 0; i < all.size(); i += 2) {
+        const SphereSet& set = all[i];
+        const double obb_volume = fit_obb(set.spheres, set.hints).volume();
+        const double capsule_volume = fit_capsule(set.spheres, set.hints).volume();
+        for (double scale : {0x1.0p-20, 0x1.0p+20}) {
+            const double cube = scale * scale * scale;
+            std::vector<Sphere> scaled = set.spheres;
+            for (Sphere& s : scaled) s = {s.center * scale, s.radius * scale};
+            EXPECT_NEAR(fit_obb(scaled, set.hints).volume() / cube, obb_volume, 1e-9 * obb_volume) << set.name;
+            EXPECT_NEAR(fit_capsule(scaled, set.hints).volume() / cube, capsule_volume, 1e-9 * capsule_volume)
+                << set.name;
+        }
+    }
+}
+
 TEST(Fit, FittersAreDeterministicAndThreadSafe) {
     // Builders may fit nodes in parallel: qhull runs on a per-call state (libqhull_r), CGAL on locals.
     std::vector<SphereSet> sets;

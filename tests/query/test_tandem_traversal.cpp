@@ -134,9 +134,15 @@ struct Case {
 };
 
 /// One builder's trees over the shared cases: all, first and two-level against brute force.
-void check_builder(const std::string& name, const std::function<Bvh(std::span<const Primitive>, std::uint64_t)>& make) {
+/// Work over all queries of check_builder: primitive tests run vs primitive pairs that exist.
+struct Work {
+    std::uint64_t primitive_tests = 0, primitive_pairs = 0;
+};
+
+Work check_builder(const std::string& name, const std::function<Bvh(std::span<const Primitive>, std::uint64_t)>& make) {
     const std::array cases{Case{1, 1, 3}, Case{2, 5, 4}, Case{13, 13, 5}, Case{27, 27, 6}, Case{27, 9, 7}, Case{40, 40, 8}};
     std::uint64_t queries = 0, intersecting = 0, root_overlaps = 0;
+    Work work;
     {
         for (const Case& c : cases) {
             const auto prims_a = generate_scene({.count = c.count_a, .seed = c.seed});
@@ -168,6 +174,8 @@ void check_builder(const std::string& name, const std::function<Bvh(std::span<co
                 const CollideResult baseline_first = collide_two_level(qa, pose_a, qb, pose_b, CollideMode::first);
                 EXPECT_EQ(baseline_first.intersecting, !expected.empty()) << where;
 
+                work.primitive_tests += reused.primitive_tests;
+                work.primitive_pairs += std::uint64_t{c.count_a} * c.count_b;
                 ++queries;
                 intersecting += expected.empty() ? 0 : 1;
                 root_overlaps += reused.nodes_visited > 0 ? 1 : 0;
@@ -178,6 +186,7 @@ void check_builder(const std::string& name, const std::function<Bvh(std::span<co
     EXPECT_GT(root_overlaps, queries * 3 / 4);
     EXPECT_GT(intersecting, queries / 4);
     EXPECT_LT(intersecting, queries);
+    return work;
 }
 
 TEST(TandemTraversal, MatchesBruteForceForEveryAlgorithm) {
@@ -191,7 +200,9 @@ TEST(TandemTraversal, MatchesBruteForceForEveryAlgorithm) {
 }
 
 TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
-    check_builder("deep-mixed", build_deep_mixed);
+    const Work work = check_builder("deep-mixed", build_deep_mixed);
+    // A real hierarchy must prune: far fewer primitive tests than the two-level method's all pairs.
+    EXPECT_LT(work.primitive_tests, work.primitive_pairs / 2);
 }
 
 TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {

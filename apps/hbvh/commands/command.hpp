@@ -28,6 +28,8 @@ void add_build_command(CLI::App& app, Command& command);
 void add_stats_command(CLI::App& app, Command& command);
 void add_generate_command(CLI::App& app, Command& command);
 void add_compare_command(CLI::App& app, Command& command);
+void add_collide_command(CLI::App& app, Command& command);
+void add_simulate_command(CLI::App& app, Command& command);
 
 /// A loaded input: always the primitives; the hierarchy too when the file nests volumes.
 struct Model {

@@ -16,12 +16,12 @@ struct StatsArguments {
     bool json = false;
 };
 
-nlohmann::json to_json(const Summary& summary) {
+nlohmann::ordered_json to_json(const Summary& summary) {
     return {{"min", summary.min}, {"mean", summary.mean}, {"max", summary.max}};
 }
 
-nlohmann::json to_json(const Stats& stats) {
-    nlohmann::json types;
+nlohmann::ordered_json to_json(const Stats& stats) {
+    nlohmann::ordered_json types;
     for (BvType type : all_bv_types) types[std::string(to_string(type))] = stats.types[static_cast<std::size_t>(type)];
     return {{"cost", stats.cost},
             {"height", stats.height},
