@@ -2,6 +2,7 @@
 // B&B-Tightest's candidate heuristic: greedy growth by Eq. 1 tightness (survey §3, Fig. 10).
 #include <algorithm>
 #include <limits>
+#include <set>
 
 #include "hbvh/build/candidates.hpp"
 
@@ -11,6 +12,10 @@ std::vector<std::vector<std::uint32_t>> tightest_candidates(const Level& level) 
     const std::uint32_t n = level.size();
     std::vector<std::vector<std::uint32_t>> sets;
     std::vector<std::uint32_t> grown;
+    // The next growth step depends on the current set alone, so once a start's growth reaches a set that an
+    // earlier start already grew through, the rest of its chain repeats that one: stop there. Same
+    // candidates after duplicates are removed, far fewer fits (chains from mutual neighbours merge early).
+    std::set<std::vector<std::uint32_t>> grown_through;
     for (std::uint32_t start = 0; start < n; ++start) {
         std::vector<std::uint32_t> group{start};
         std::vector<bool> in_group(n, false);
@@ -32,6 +37,7 @@ std::vector<std::vector<std::uint32_t>> tightest_candidates(const Level& level) 
             }
             group.insert(std::upper_bound(group.begin(), group.end(), best), best);
             in_group[best] = true;
+            if (!grown_through.insert(group).second) break;
             sets.push_back(group);
         }
     }

@@ -33,7 +33,8 @@ struct FittedGroup {
 
 /// A level of the bottom-up build: its nodes in canonical order (docs/algorithms.md: sorted by the centre
 /// of their world AABB, then volume, so that node indices do not depend on the input order) and a memo of
-/// fitted groups shared by the candidate heuristic and the candidate costs.
+/// fitted groups shared by the candidate heuristic and the candidate costs. The memo makes const calls
+/// mutate: one Level must not be used from several threads at once.
 class Level {
 public:
     /// `nodes` must already be in canonical order (build_bottom_up sorts them); `primitives` is the input.

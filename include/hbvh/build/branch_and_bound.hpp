@@ -14,8 +14,8 @@ namespace hbvh {
 /// Options of bnb-tightest and bnb-enlarge.
 struct BranchAndBoundOptions {
     /// Per solver call (one per level, one more per fallback). The default node limit keeps the survey's
-    /// exponential search to about a second per level and, unlike a time limit, is deterministic.
-    SolverBudget budget{20'000'000, 0.0};
+    /// exponential search to roughly 0.1 s per call and, unlike a time limit, is deterministic.
+    SolverBudget budget{1'000'000, 0.0};
     /// The set-partition solver; empty means solve_reference_branch_and_bound (the survey's).
     LevelSolver solver;
     /// B&B-Enlarge's heuristic.

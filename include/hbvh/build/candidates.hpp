@@ -11,8 +11,9 @@ namespace hbvh {
 
 /// B&B-Tightest's heuristic (§3, Fig. 10). From each node, repeatedly add the node whose joint BV (fitted
 /// around all covered primitives) has the smallest Eq. 1 tightness, saving every set of size >= 2 on the
-/// way, until the set holds the whole level. Ties go to the lower canonical node index. Returns at most
-/// n (n - 1) sets before the driver removes duplicates; O(n^3) group fits, memoised by `level`.
+/// way, until the set holds the whole level. Ties go to the lower canonical node index. A growth that
+/// reaches a set an earlier start already grew through stops there (the rest would repeat it), so every
+/// set is returned once; at most n (n - 1) sets and O(n^3) group fits, memoised by `level`.
 [[nodiscard]] std::vector<std::vector<std::uint32_t>> tightest_candidates(const Level& level);
 
 /// Knobs of B&B-Enlarge's heuristic; the defaults are the survey's.
