@@ -3,6 +3,7 @@
 
 #include <array>
 
+#include "hbvh/build/optimal.hpp"
 #include "hbvh/build/two_level.hpp"
 
 namespace hbvh {
@@ -16,6 +17,8 @@ constexpr std::array registry{
     AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)"},
     AlgorithmInfo{Algorithm::bnb_tightest, "bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound"},
     AlgorithmInfo{Algorithm::bnb_enlarge, "bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound"},
+    AlgorithmInfo{Algorithm::bnb_exact, "bnb-exact", "bottom-up levels, Tightest+Enlarge+kNN candidates, exact set partition; never worse than bnb-enlarge"},
+    AlgorithmInfo{Algorithm::optimal, "optimal", "globally optimal Eq. 2 hierarchy by subset DP; at most 18 primitives by default"},
 };
 }  // namespace
 
@@ -47,6 +50,8 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
             return build_bnb_tightest(primitives, options.policy, options.branch_and_bound, options.report);
         case Algorithm::bnb_enlarge:
             return build_bnb_enlarge(primitives, options.policy, options.branch_and_bound, options.report);
+        case Algorithm::bnb_exact: return build_bnb_exact(primitives, options.policy, options.bnb_exact, options.report);
+        case Algorithm::optimal: return build_optimal(primitives, options.policy, options.optimal, options.report);
     }
     return Error{"unknown algorithm", "", 0};
 }

@@ -7,11 +7,13 @@
 #include <span>
 #include <string_view>
 
+#include "hbvh/build/bnb_exact.hpp"
 #include "hbvh/build/bottom_up_merge.hpp"
 #include "hbvh/build/branch_and_bound.hpp"
 #include "hbvh/build/incremental_insert.hpp"
 #include "hbvh/build/incremental_insert_haber.hpp"
 #include "hbvh/build/obb_tree.hpp"
+#include "hbvh/build/optimal.hpp"
 #include "hbvh/build/report.hpp"
 #include "hbvh/build/top_down_split.hpp"
 #include "hbvh/fit/volume_policy.hpp"
@@ -29,6 +31,8 @@ enum class Algorithm {
     obb_tree,
     bnb_tightest,
     bnb_enlarge,
+    optimal,
+    bnb_exact,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -53,6 +57,8 @@ struct BuildOptions {
     SplitOptions split;              ///< For Algorithm::split.
     ObbTreeOptions obb_tree;         ///< For Algorithm::obb_tree.
     BranchAndBoundOptions branch_and_bound;  ///< bnb-tightest, bnb-enlarge.
+    OptimalOptions optimal;         ///< For Algorithm::optimal.
+    ExactBottomUpOptions bnb_exact;  ///< For Algorithm::bnb_exact.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
