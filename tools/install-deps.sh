@@ -10,8 +10,11 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libccd-dev
   libmujoco-dev libmujoco-samples liburdfdom-dev libassimp-dev
   libbullet-dev libfcl-dev graphviz
+  chromium
 )
 missing=()
+# Node may come from elsewhere than Debian (its npm then comes with it): ask Debian only when absent.
+command -v npm >/dev/null 2>&1 || packages+=(nodejs npm)
 for package in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed" || missing+=("$package")
 done
@@ -21,4 +24,9 @@ if [ ${#missing[@]} -gt 0 ]; then
   [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
   "${sudo_cmd[@]}" apt-get update -qq
   DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+
+# The Khronos glTF validator, pinned by tools/package-lock.json (npm registry only).
+if [ ! -d "$(dirname "$0")/node_modules/gltf-validator" ]; then
+  npm ci --prefix "$(dirname "$0")" --no-audit --no-fund --loglevel=error
 fi
