@@ -3,12 +3,22 @@
 
 #include <array>
 
+#include "hbvh/build/optimal.hpp"
 #include "hbvh/build/two_level.hpp"
 
 namespace hbvh {
 namespace {
 constexpr std::array registry{
     AlgorithmInfo{Algorithm::two_level, "two-level", "the survey's baseline: one root BV (best allowed type) over all primitives"},
+    AlgorithmInfo{Algorithm::bnb_tightest, "bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound"},
+    AlgorithmInfo{Algorithm::bnb_enlarge, "bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound"},
+    AlgorithmInfo{Algorithm::bnb_exact, "bnb-exact", "bottom-up levels, Tightest+Enlarge+kNN candidates, exact set partition; never worse than bnb-enlarge"},
+    AlgorithmInfo{Algorithm::optimal, "optimal", "globally optimal Eq. 2 hierarchy by subset DP; at most 18 primitives by default"},
+    AlgorithmInfo{Algorithm::merge, "merge", "OpenTissue bottom-up merge: collapse cheapest edges of an enlarged-overlap graph (survey 2.3)"},
+    AlgorithmInfo{Algorithm::insertion, "insertion", "Goldsmith-Salmon incremental insertion in input order (survey 2.1)"},
+    AlgorithmInfo{Algorithm::insertion_haber, "insertion-haber", "insertion with Haber et al.'s extra rule, re-insertion and ill-formed-group elimination (survey 2.1)"},
+    AlgorithmInfo{Algorithm::split, "split", "Mueller et al. top-down split at the cheapest sorted cut on x, y or z (survey 2.2)"},
+    AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)"},
 };
 }  // namespace
 
@@ -30,6 +40,18 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
     switch (algorithm) {
         case Algorithm::two_level: return build_two_level(primitives, options.policy);
+        case Algorithm::bnb_tightest:
+            return build_bnb_tightest(primitives, options.policy, options.branch_and_bound, options.report);
+        case Algorithm::bnb_enlarge:
+            return build_bnb_enlarge(primitives, options.policy, options.branch_and_bound, options.report);
+        case Algorithm::bnb_exact: return build_bnb_exact(primitives, options.policy, options.bnb_exact, options.report);
+        case Algorithm::optimal: return build_optimal(primitives, options.policy, options.optimal, options.report);
+        case Algorithm::merge: return build_bottom_up_merge(primitives, options.policy, options.merge);
+        case Algorithm::insertion: return build_incremental_insert(primitives, options.policy, options.insertion);
+        case Algorithm::insertion_haber:
+            return build_incremental_insert_haber(primitives, options.policy, options.insertion_haber);
+        case Algorithm::split: return build_top_down_split(primitives, options.policy, options.split);
+        case Algorithm::obb_tree: return build_obb_tree(primitives, options.policy, options.obb_tree);
     }
     return Error{"unknown algorithm", "", 0};
 }

@@ -7,7 +7,15 @@
 #include <span>
 #include <string_view>
 
+#include "hbvh/build/bnb_exact.hpp"
+#include "hbvh/build/bottom_up_merge.hpp"
+#include "hbvh/build/branch_and_bound.hpp"
+#include "hbvh/build/incremental_insert.hpp"
+#include "hbvh/build/incremental_insert_haber.hpp"
+#include "hbvh/build/obb_tree.hpp"
+#include "hbvh/build/optimal.hpp"
 #include "hbvh/build/report.hpp"
+#include "hbvh/build/top_down_split.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
@@ -16,6 +24,15 @@ namespace hbvh {
 
 enum class Algorithm {
     two_level,
+    bnb_tightest,
+    bnb_enlarge,
+    optimal,
+    bnb_exact,
+    merge,
+    insertion,
+    insertion_haber,
+    split,
+    obb_tree,
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -34,6 +51,14 @@ struct AlgorithmInfo {
 struct BuildOptions {
     VolumePolicy policy;
     BuildReport* report = nullptr;  ///< Filled when non-null.
+    BranchAndBoundOptions branch_and_bound;  ///< bnb-tightest, bnb-enlarge.
+    OptimalOptions optimal;         ///< For Algorithm::optimal.
+    ExactBottomUpOptions bnb_exact;  ///< For Algorithm::bnb_exact.
+    MergeOptions merge;              ///< For Algorithm::merge.
+    InsertionOptions insertion;      ///< For Algorithm::insertion.
+    HaberInsertionOptions insertion_haber;  ///< For Algorithm::insertion_haber.
+    SplitOptions split;              ///< For Algorithm::split.
+    ObbTreeOptions obb_tree;         ///< For Algorithm::obb_tree.
 };
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).

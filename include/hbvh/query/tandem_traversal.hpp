@@ -47,7 +47,9 @@ public:
     /// Converts `bvh`. An empty Bvh gives an empty tree, which collides with nothing.
     explicit QueryTree(const Bvh& bvh);
 
+    /// True for a tree converted from an empty Bvh.
     [[nodiscard]] bool empty() const { return nodes_.empty(); }
+    /// All nodes, root first, breadth-first as in the Bvh (model frame).
     [[nodiscard]] std::span<const QueryNode> nodes() const { return nodes_; }
     /// Leaf node index of each primitive, in input order.
     [[nodiscard]] std::span<const std::uint32_t> primitive_nodes() const { return primitive_nodes_; }

@@ -1,0 +1,26 @@
+// SPDX-License-Identifier: MIT
+// Goldsmith and Salmon's incremental insertion (survey §2.1): primitives enter one at a time at the cheapest place.
+#pragma once
+
+#include <span>
+
+#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+/// Knobs of build_incremental_insert (none yet; kept for the common builder shape, STYLE.md §3).
+struct InsertionOptions {};
+
+/// Inserts the primitives in input order. Each one descends a single path from the root, at every group
+/// g pricing, as an increase of Eq. 2, rule 1 (p becomes a child of g) and rule 2 (p and a child p' of g
+/// form a new group under g), then follows rule 3 into the child group whose own Eq. 2 term grows least
+/// (ties: nearest centre). The cheapest rule seen on the path wins (Haines' refinement). Candidate
+/// volumes are estimated by fit_best around the node's BV and p; after the insertion every BV on the
+/// path is refit exactly (fit_best over the covered primitives). The result depends on input order,
+/// as the survey notes. Error: empty input.
+[[nodiscard]] Result<Bvh> build_incremental_insert(std::span<const Primitive> primitives, const VolumePolicy& policy,
+                                                   const InsertionOptions& options = {});
+
+}  // namespace hbvh

@@ -1,0 +1,172 @@
+// SPDX-License-Identifier: MIT
+// The survey's heuristic builders (§2.1-2.3) through build(): shared properties, order (in)dependence.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "hbvh/build/build.hpp"
+#include "hbvh/io/xml.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/stats.hpp"
+#include "hbvh/tree/validate.hpp"
+
+
+namespace hbvh {
+namespace {
+
+constexpr Algorithm heuristic_builders[] = {Algorithm::merge, Algorithm::insertion, Algorithm::insertion_haber,
+                                            Algorithm::split, Algorithm::obb_tree};
+constexpr Algorithm order_independent_builders[] = {Algorithm::merge, Algorithm::split, Algorithm::obb_tree};
+constexpr Algorithm order_dependent_builders[] = {Algorithm::insertion, Algorithm::insertion_haber};
+
+// The shared property check: every primitive in exactly one leaf, leaves carry their primitive, no inner
+// node with one child, every node's BV contains the generating spheres of every covered primitive
+// (relative tolerance 1e-9 of the node's size), and validate() agrees. Returns the built hierarchy.
+Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorithm, const BuildOptions& options = {}) {
+    SCOPED_TRACE(std::string(to_string(algorithm)) + " over " + std::to_string(primitives.size()) + " primitives");
+    Result<Bvh> built = build(primitives, algorithm, options);
+    EXPECT_TRUE(built.has_value()) << (built.has_value() ? "" : built.error().to_string());
+    if (!built.has_value()) return {};
+    const Bvh& bvh = built.value();
+    EXPECT_EQ(bvh.primitives.size(), primitives.size());
+    std::vector<int> seen(primitives.size(), 0);
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const Node& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            EXPECT_LT(node.primitive, primitives.size());
+            if (node.primitive < primitives.size()) ++seen[node.primitive];
+            continue;
+        }
+        EXPECT_GE(node.child_count, 2u) << "node " << i;
+        const double tolerance = 1e-9 * size_scale(node.volume);
+        for (const std::uint32_t p : covered_primitives(bvh, i))
+            for (const Sphere& s : generating_spheres(primitives[p].volume))
+                EXPECT_TRUE(contains(node.volume, s, tolerance)) << "node " << i << " misses primitive " << p;
+    }
+    for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
+    const Status valid = validate(bvh);
+    EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
+    return bvh;
+}
+
+std::vector<Primitive> scene(std::uint32_t count, std::uint64_t seed, bool clustered = true) {
+    SceneOptions options;
+    options.count = count;
+    options.seed = seed;
+    options.clustered = clustered;
+    return generate_scene(options);
+}
+
+std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
+    SplitMix64 random(seed);
+    for (std::size_t i = primitives.size(); i > 1; --i) std::swap(primitives[i - 1], primitives[random.below(i)]);
+    return primitives;
+}
+
+double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm) {
+    Result<Bvh> built = build(primitives, algorithm);
+    EXPECT_TRUE(built.has_value());
+    return built.has_value() ? cost(built.value()) : -1.0;
+}
+
+// One test per builder, so each stays short and a failure names its builder.
+class EveryHeuristic : public testing::TestWithParam<Algorithm> {};
+
+TEST_P(EveryHeuristic, PropertiesOnGeneratedScenesOfEverySize) {
+    for (std::uint32_t count = 1; count <= 60; ++count)
+        check_properties(scene(count, 1000 + count, count % 2 == 0), GetParam());
+}
+
+INSTANTIATE_TEST_SUITE_P(SurveyHeuristics, EveryHeuristic, testing::ValuesIn(heuristic_builders),
+                         [](const testing::TestParamInfo<Algorithm>& param) {
+                             std::string name(to_string(param.param));
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name;
+                         });
+
+TEST(SurveyHeuristics, PropertiesUnderRestrictedPolicies) {
+    const std::vector<Primitive> primitives = scene(40, 7);
+    for (const BvType only : all_bv_types) {
+        BuildOptions options;
+        options.policy = VolumePolicy::only(only);
+        for (const Algorithm algorithm : heuristic_builders) {
+            const Bvh bvh = check_properties(primitives, algorithm, options);
+            for (const Node& node : bvh.nodes) {
+                if (!node.is_leaf()) {
+                    EXPECT_EQ(type_of(node.volume), only);
+                }
+            }
+        }
+    }
+}
+
+TEST(SurveyHeuristics, DegenerateInputs) {
+    // Identical primitives and coincident points: every split and every enlargement degenerates.
+    std::vector<Primitive> same(9, Primitive{Sphere{Vec3(1, 2, 3), 0.5}, ""});
+    std::vector<Primitive> points(7, Primitive{Sphere{Vec3::Zero(), 0.0}, ""});
+    points[3].volume = Sphere{Vec3(5, 0, 0), 0.0};
+    for (const Algorithm algorithm : heuristic_builders) {
+        check_properties(same, algorithm);
+        check_properties(points, algorithm);
+        EXPECT_FALSE(build(std::vector<Primitive>{}, algorithm).has_value());
+    }
+}
+
+TEST(SurveyHeuristics, MergeBranchingFactorIsAnOption) {
+    const std::vector<Primitive> primitives = scene(50, 11);
+    for (const std::uint32_t factor : {2u, 3u, 4u, 8u}) {
+        BuildOptions options;
+        options.merge.branching_factor = factor;
+        check_properties(primitives, Algorithm::merge, options);
+    }
+}
+
+TEST(SurveyHeuristics, CostIsIndependentOfInputOrder) {
+    for (const Algorithm algorithm : order_independent_builders)
+        for (const std::uint32_t count : {2u, 7u, 25u, 60u}) {
+            const std::vector<Primitive> primitives = scene(count, 77 + count, count % 2 == 1);
+            const double reference = cost_of(primitives, algorithm);
+            for (std::uint64_t shuffle = 1; shuffle <= 4; ++shuffle) {
+                const double c = cost_of(shuffled(primitives, shuffle), algorithm);
+                EXPECT_NEAR(c, reference, 1e-9 * std::abs(reference))
+                    << to_string(algorithm) << ", " << count << " primitives, shuffle " << shuffle;
+            }
+        }
+}
+
+TEST(SurveyHeuristics, InsertionDependsOnInputOrder) {
+    // The survey's complaint about insertion (§2.1): some shuffle of this scene changes the hierarchy.
+    const std::vector<Primitive> primitives = scene(30, 5);
+    for (const Algorithm algorithm : order_dependent_builders) {
+        const double reference = cost_of(primitives, algorithm);
+        bool changed = false;
+        for (std::uint64_t shuffle = 1; shuffle <= 8 && !changed; ++shuffle)
+            changed = std::abs(cost_of(shuffled(primitives, shuffle), algorithm) - reference) > 1e-9 * reference;
+        EXPECT_TRUE(changed) << to_string(algorithm);
+    }
+}
+
+TEST(SurveyHeuristics, BundledModels) {
+    std::vector<std::filesystem::path> files;
+    for (const char* dir : {HBVH_SOURCE_DIR "/data/models", HBVH_SHARED_DIR "/data/models"}) {
+        std::error_code error;
+        if (!std::filesystem::is_directory(dir, error)) continue;
+        for (const auto& entry : std::filesystem::directory_iterator(dir, error))
+            if (entry.path().extension() == ".xml") files.push_back(entry.path());
+    }
+    if (files.empty()) GTEST_SKIP() << "no data/models/*.xml";
+    std::sort(files.begin(), files.end());
+    for (const auto& file : files) {
+        Result<XmlModel> model = read_xml_file(file);
+        if (!model.has_value()) continue;  // not an hbvh model file (other formats share the folder)
+        SCOPED_TRACE(file.filename().string());
+        for (const Algorithm algorithm : heuristic_builders) check_properties(model->primitives, algorithm);
+    }
+}
+
+}  // namespace
+}  // namespace hbvh
