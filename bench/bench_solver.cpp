@@ -172,5 +172,3 @@ BENCHMARK(BM_optimal_build)->Args({13, 0})->Args({15, 0})->Args({17, 0})->Args({
 
 }  // namespace
 }  // namespace hbvh
-
-BENCHMARK_MAIN();

@@ -111,6 +111,7 @@ struct LevelContext {
     const VolumePolicy& policy;
     const ScaleOptions& options;
     std::uint32_t exact_fit_max_primitives = 0;  ///< Groups up to this size use fit_best.
+    bool exact_final_fit = false;                ///< Chosen groups are refitted with fit_best too.
     std::span<const ScaleNode> nodes;
     std::span<const std::uint32_t> level_primitives;  ///< Input indices; node runs index into it.
     Clock::time_point deadline;
@@ -271,6 +272,12 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
             BoundingVolume tight = fit_group(level, group.members, primitive_count, false);
             if (level.policy.weighted_volume(tight) <= level.policy.weighted_volume(group.volume))
                 group.volume = std::move(tight);
+            if (level.exact_final_fit) {
+                const FitInput input = primitive_input(level, group.members);
+                BoundingVolume best = fit_best(input.spheres, level.policy, input.hint_axes);
+                if (level.policy.weighted_volume(best) < level.policy.weighted_volume(group.volume))
+                    group.volume = std::move(best);
+            }
         }
         group.weighted_volume = level.policy.weighted_volume(group.volume);
         result.groups.push_back(std::move(group));
@@ -307,7 +314,8 @@ Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& polic
         const std::size_t window_count = bounds.size() - 1;
 
         const std::uint32_t exact_limit = n0 <= options.exact_fit_all_up_to ? n0 : options.exact_fit_max_primitives;
-        LevelContext level{primitives, policy, options, exact_limit, nodes, level_primitives, {}, false};
+        LevelContext level{primitives, policy, options, exact_limit, n <= options.exact_fit_level_nodes,
+                           nodes, level_primitives, {}, false};
         if (options.time_limit_seconds > 0.0) {
             level.has_deadline = true;
             level.deadline = start + std::chrono::duration_cast<Clock::duration>(

@@ -28,6 +28,9 @@ struct ScaleOptions {
     /// Inputs of at most this many primitives use fit_best for every group (it is affordable there, and
     /// the tree is then comparable with optimal and bnb-exact, which use fit_best throughout).
     std::uint32_t exact_fit_all_up_to = 64;
+    /// On levels of at most this many nodes the chosen groups are refitted with fit_best as well: the top
+    /// levels' few big BVs dominate Eq. 2, and there are only a few hundred of them.
+    std::uint32_t exact_fit_level_nodes = 256;
     /// Per window solve_exact budget. A node limit, unlike a time limit, keeps the result deterministic.
     SolverBudget window_budget{20'000, 0.0};
     /// Whole-build wall-clock limit in seconds (0: none). Once passed, the remaining windows keep the
