@@ -2,7 +2,10 @@
 // `hbvh build`: primitives in, hierarchy out (the survey's XML).
 #include <fmt/core.h>
 
+#include <unistd.h>
+
 #include <chrono>
+#include <cstdio>
 
 #include "commands/command.hpp"
 #include "hbvh/io/xml.hpp"
@@ -32,6 +35,20 @@ void print_report(const BuildReport& report, double seconds) {
     fmt::print(stderr, "total: {:.3f} ms\n", 1e3 * seconds);
 }
 
+/// A progress callback drawing a bar on stderr, or an empty one when stderr is not a terminal. The bar
+/// appears only once the build has run for a second, so quick builds print nothing.
+std::function<void(double)> progress_bar(std::chrono::steady_clock::time_point start, bool& drawn) {
+    if (isatty(STDERR_FILENO) == 0) return {};
+    return [start, &drawn](double fraction) {
+        if (std::chrono::steady_clock::now() - start < std::chrono::seconds(1)) return;
+        constexpr int width = 40;
+        const int filled = static_cast<int>(fraction * width + 0.5);
+        fmt::print(stderr, "\r[{:<{}}] {:3.0f} %", std::string(static_cast<std::size_t>(filled), '#'), width, 100.0 * fraction);
+        std::fflush(stderr);
+        drawn = true;
+    };
+}
+
 int run_build(const BuildArguments& args) {
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
@@ -45,7 +62,10 @@ int run_build(const BuildArguments& args) {
     BuildReport report;
     options.report = &report;
     const auto start = std::chrono::steady_clock::now();
+    bool bar_drawn = false;
+    options.progress = progress_bar(start, bar_drawn);
     Result<Bvh> bvh = build(model->primitives, algorithm, options);
+    if (bar_drawn) fmt::print(stderr, "\n");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!bvh) return report_error(bvh.error());
     if (args.report) print_report(report, seconds);

@@ -52,9 +52,10 @@ void report_warnings(const std::vector<std::string>& warnings);
 
 /// Options that select and steer a builder, shared by build, stats, compare, collide.
 struct BuilderFlags {
-    std::string algorithm = "two-level";
+    std::string algorithm = "auto";
     std::string types = "aabb,obb,sphere,capsule";
     std::string type_weights;
+    double time_limit_seconds = 0.0;  ///< --time-limit: anytime builders return the best found by then.
     void add_to(CLI::App& command);
     /// The algorithm and options, or a usage Error.
     [[nodiscard]] Result<std::pair<Algorithm, BuildOptions>> resolve() const;

@@ -73,6 +73,9 @@ void BuilderFlags::add_to(CLI::App& command) {
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
                        "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each)");
+    command.add_option("--time-limit", time_limit_seconds,
+                       "Seconds the build may take (0 = no limit); scale and bnb-exact return their best by then")
+        ->check(CLI::NonNegativeNumber);
 }
 
 Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
@@ -86,6 +89,7 @@ Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
     }
     BuildOptions options;
     options.policy = policy.value();
+    options.time_limit_seconds = time_limit_seconds;
     return std::pair{*chosen, options};
 }
 

@@ -1,0 +1,165 @@
+// SPDX-License-Identifier: MIT
+// The scale builder: tree properties, thread-count independence, quality against merge/split, and auto.
+#include <gtest/gtest.h>
+
+#include <tbb/global_control.h>
+
+#include <string>
+#include <vector>
+
+#include "hbvh/build/build.hpp"
+#include "hbvh/build/scale.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/stats.hpp"
+#include "hbvh/tree/validate.hpp"
+
+namespace hbvh {
+namespace {
+
+std::vector<Primitive> scene(std::uint32_t count, std::uint64_t seed, bool clustered = true) {
+    SceneOptions options;
+    options.count = count;
+    options.seed = seed;
+    options.clustered = clustered;
+    return generate_scene(options);
+}
+
+// Every primitive in exactly one leaf, no inner node with one child, and every node's BV contains the
+// generating spheres of every primitive it covers (relative tolerance 1e-9 of the node's size).
+void check_properties(const std::vector<Primitive>& primitives, const Bvh& bvh) {
+    ASSERT_EQ(bvh.primitives.size(), primitives.size());
+    std::vector<int> seen(primitives.size(), 0);
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const Node& node = bvh.nodes[i];
+        if (node.is_leaf()) {
+            ASSERT_LT(node.primitive, primitives.size());
+            ++seen[node.primitive];
+            continue;
+        }
+        EXPECT_GE(node.child_count, 2u) << "node " << i;
+        const double tolerance = 1e-9 * size_scale(node.volume);
+        for (const std::uint32_t p : covered_primitives(bvh, i))
+            for (const Sphere& s : generating_spheres(primitives[p].volume))
+                ASSERT_TRUE(contains(node.volume, s, tolerance)) << "node " << i << " misses primitive " << p;
+    }
+    for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
+    const Status valid = validate(bvh);
+    EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
+}
+
+TEST(Scale, PropertiesOnGeneratedScenes) {
+    for (std::uint32_t count : {1u, 2u, 3u, 4u, 5u, 7u, 33u, 100u, 257u, 1000u, 5000u}) {
+        for (bool clustered : {true, false}) {
+            SCOPED_TRACE(std::to_string(count) + (clustered ? " clustered" : " uniform"));
+            const std::vector<Primitive> primitives = scene(count, 100 + count, clustered);
+            BuildReport report;
+            const Bvh bvh = build_scale(primitives, VolumePolicy::all(), {}, &report);
+            check_properties(primitives, bvh);
+            if (count > 1) {
+                EXPECT_FALSE(report.levels.empty());
+            }
+            if (count > 1000) break;  // one 5000 scene is enough for the time budget
+        }
+    }
+}
+
+TEST(Scale, PropertiesWithRestrictedPolicies) {
+    const std::vector<Primitive> primitives = scene(600, 7);
+    for (BvType type : all_bv_types) {
+        SCOPED_TRACE(std::string(to_string(type)));
+        const VolumePolicy policy = VolumePolicy::only(type);
+        const Bvh bvh = build_scale(primitives, policy);
+        check_properties(primitives, bvh);
+        for (const Node& node : bvh.nodes)
+            if (!node.is_leaf()) {
+                EXPECT_EQ(type_of(node.volume), type);
+            }
+    }
+}
+
+TEST(Scale, SameHierarchyForOneAndTwoThreads) {
+    const std::vector<Primitive> primitives = scene(3000, 42);
+    const auto build_with = [&](std::size_t threads) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        return build_scale(primitives, VolumePolicy::all());
+    };
+    const Bvh one = build_with(1);
+    const Bvh two = build_with(2);
+    EXPECT_EQ(cost(one), cost(two));
+    ASSERT_EQ(one.nodes.size(), two.nodes.size());
+    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+        const Node& a = one.nodes[i];
+        const Node& b = two.nodes[i];
+        ASSERT_EQ(a.child_count, b.child_count) << "node " << i;
+        ASSERT_EQ(a.first_child, b.first_child) << "node " << i;
+        ASSERT_EQ(a.primitive, b.primitive) << "node " << i;
+        ASSERT_EQ(a.volume.index(), b.volume.index()) << "node " << i;
+        // Bit-identical BVs: same fitter, same inputs in the same order.
+        ASSERT_EQ(generating_spheres(a.volume).size(), generating_spheres(b.volume).size());
+        const auto sa = generating_spheres(a.volume), sb = generating_spheres(b.volume);
+        for (std::size_t k = 0; k < sa.size(); ++k) {
+            ASSERT_EQ(sa[k].center, sb[k].center) << "node " << i;
+            ASSERT_EQ(sa[k].radius, sb[k].radius) << "node " << i;
+        }
+    }
+}
+
+// merge is beaten on every scene. split is not: its top-down cuts give 30-40 % lower Eq. 2 costs than
+// scale's local bottom-up windows (docs/scale.md §4), so the ratio is recorded, not asserted.
+TEST(Scale, NoWorseThanMergeAndRatioToSplitRecorded) {
+    for (const auto& [count, seed] : {std::pair{1000u, 5u}, std::pair{1500u, 6u}}) {
+        SCOPED_TRACE(std::to_string(count));
+        const std::vector<Primitive> primitives = scene(count, seed);
+        const double scale_cost = cost(build_scale(primitives, VolumePolicy::all()));
+        Result<Bvh> merged = build(primitives, Algorithm::merge);
+        ASSERT_TRUE(merged.has_value());
+        EXPECT_LE(scale_cost, cost(merged.value()));
+        Result<Bvh> split = build(primitives, Algorithm::split);
+        ASSERT_TRUE(split.has_value());
+        RecordProperty("scale_over_split_" + std::to_string(count), std::to_string(scale_cost / cost(split.value())));
+    }
+}
+
+TEST(Scale, ReportsProgressUpToOne) {
+    std::vector<double> fractions;
+    ScaleOptions options;
+    options.progress = [&](double f) { fractions.push_back(f); };
+    (void)build_scale(scene(500, 3), VolumePolicy::all(), options);
+    ASSERT_FALSE(fractions.empty());
+    for (std::size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1]);
+    EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
+}
+
+TEST(Scale, TimeLimitStillGivesAValidTree) {
+    const std::vector<Primitive> primitives = scene(2000, 9);
+    ScaleOptions options;
+    options.time_limit_seconds = 1e-6;  // past at once: every window keeps its initial cover
+    BuildReport report;
+    const Bvh bvh = build_scale(primitives, VolumePolicy::all(), options, &report);
+    check_properties(primitives, bvh);
+    EXPECT_TRUE(report.budget_hit);
+}
+
+TEST(Auto, PicksBySizeAndSaysSo) {
+    EXPECT_EQ(auto_choice(1), Algorithm::optimal);
+    EXPECT_EQ(auto_choice(auto_optimal_max_primitives), Algorithm::optimal);
+    EXPECT_EQ(auto_choice(auto_optimal_max_primitives + 1), Algorithm::bnb_exact);
+    EXPECT_EQ(auto_choice(auto_exact_max_primitives), Algorithm::bnb_exact);
+    EXPECT_EQ(auto_choice(auto_exact_max_primitives + 1), Algorithm::scale);
+    ASSERT_EQ(parse_algorithm("auto"), Algorithm::automatic);
+    for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_exact_max_primitives + 10}) {
+        const std::vector<Primitive> primitives = scene(count, count);
+        BuildReport report;
+        BuildOptions options;
+        options.report = &report;
+        Result<Bvh> built = build(primitives, Algorithm::automatic, options);
+        ASSERT_TRUE(built.has_value());
+        check_properties(primitives, built.value());
+        ASSERT_FALSE(report.notes.empty());
+        EXPECT_NE(report.notes.back().find(std::string(to_string(auto_choice(count)))), std::string::npos)
+            << report.notes.back();
+    }
+}
+
+}  // namespace
+}  // namespace hbvh
