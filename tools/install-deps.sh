@@ -10,6 +10,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev libccd-dev
   libmujoco-dev libmujoco-samples liburdfdom-dev libassimp-dev
   libbullet-dev libfcl-dev graphviz
+  clang libclang-rt-14-dev
 )
 missing=()
 for package in "${packages[@]}"; do
