@@ -51,6 +51,7 @@ class BulletPeer final : public Peer {
 public:
     explicit BulletPeer(std::span<const Primitive> primitives)
         : dispatcher_(&configuration_), compound_(/*enableDynamicAabbTree=*/true, static_cast<int>(primitives.size())) {
+        const auto start = std::chrono::steady_clock::now();
         children_.reserve(primitives.size());
         for (const Primitive& primitive : primitives) {
             const LocalShape shape = to_local_shape(primitive.volume);
@@ -70,6 +71,7 @@ public:
             children_.push_back(std::move(child));
         }
         compound_.setMargin(0.0);
+        build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         object_a_.setCollisionShape(&compound_);
         object_b_.setCollisionShape(&compound_);
         object_a_.setWorldTransform(btTransform::getIdentity());
@@ -101,6 +103,7 @@ public:
         pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
     }
 
+    [[nodiscard]] double build_seconds() const override { return build_seconds_; }
     [[nodiscard]] double cost() const override { return dbvt_cost(compound_.getDynamicAabbTree()->m_root); }
 
 private:
@@ -112,6 +115,7 @@ private:
     btCollisionObject object_a_;
     btCollisionObject object_b_;
     btCollisionAlgorithm* algorithm_ = nullptr;
+    double build_seconds_ = 0.0;
 };
 
 }  // namespace

@@ -200,7 +200,9 @@ void run_object(const Object& object, const Options& options, std::vector<Row>& 
     const Algorithm algorithm = pick_algorithm();
     const std::size_t n = object.primitives.size();
     const int build_repetitions = 5;
-    BuildRow build_row{object.name, n};
+    BuildRow build_row;
+    build_row.object = object.name;
+    build_row.primitives = n;
 
     // Build times: median of a few builds each, the last one kept.
     std::vector<double> times;
@@ -215,22 +217,16 @@ void run_object(const Object& object, const Options& options, std::vector<Row>& 
     build_row.hbvh_ms = 1e3 * median(times);
     build_row.hbvh_cost = cost(*bvh);
     std::unique_ptr<Peer> bullet, fcl;
-    times.clear();
+    std::vector<double> bullet_times, fcl_times;
     for (int r = 0; r < build_repetitions; ++r) {
-        const auto start = Clock::now();
         bullet = make_bullet_peer(object.primitives);
-        times.push_back(seconds_since(start));
-    }
-    build_row.bullet_ms = 1e3 * median(times);
-    build_row.bullet_cost = bullet->cost();
-    times.clear();
-    for (int r = 0; r < build_repetitions; ++r) {
-        const auto start = Clock::now();
+        bullet_times.push_back(bullet->build_seconds());
         fcl = make_fcl_peer(object.primitives);
-        times.push_back(seconds_since(start));
+        fcl_times.push_back(fcl->build_seconds());
     }
-    // FCL builds both copies' managers: half of it is one object's setup.
-    build_row.fcl_ms = 0.5e3 * median(times);
+    build_row.bullet_ms = 1e3 * median(bullet_times);
+    build_row.bullet_cost = bullet->cost();
+    build_row.fcl_ms = 1e3 * median(fcl_times);
     build_row.fcl_cost = fcl->cost();
     builds.push_back(build_row);
 
@@ -241,7 +237,11 @@ void run_object(const Object& object, const Options& options, std::vector<Row>& 
 
     for (Regime regime : {Regime::partial, Regime::near, Regime::total}) {
         const std::vector<RigidTransform> poses = make_poses(*bvh, *tree, regime, options.poses);
-        Row row{object.name, n, regime, poses.size()};
+        Row row;
+        row.object = object.name;
+        row.primitives = n;
+        row.regime = regime;
+        row.poses = poses.size();
         if (poses.empty()) {
             rows.push_back(row);
             continue;

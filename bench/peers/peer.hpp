@@ -2,6 +2,7 @@
 // The interface hbvh_peers drives Bullet and FCL through, and the primitive shape both are built from.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -40,6 +41,9 @@ public:
     virtual void collide(PairList& pairs) = 0;
     /// Eq. 2 of the engine's own tree over one copy (model frame): sum over inner nodes of 2 x AABB volume.
     [[nodiscard]] virtual double cost() const = 0;
+    /// Seconds the constructor spent building one copy's structure (shapes and tree), without engine
+    /// set-up that a program does once (Bullet's collision configuration and dispatcher).
+    [[nodiscard]] virtual double build_seconds() const = 0;
 };
 
 /// Bullet: one btCompoundShape (dynamic AABB tree on, margins 0), compound-vs-compound through the dispatcher.
