@@ -11,7 +11,7 @@ file(MAKE_DIRECTORY ${HBVH_CLI_OUT})
 
 # hbvh_cli_test(<name> <exit code> <stderr regex or ""> <cli arguments...>)
 function(hbvh_cli_test name exit_code regex)
-  string(REPLACE ";" "\\;" args "${ARGN}")
+  string(JOIN "|" args ${ARGN})  # a list cannot pass through -D intact; expect.cmake splits it again
   set(expect_stderr "")
   if(NOT regex STREQUAL "")
     set(expect_stderr "-DEXPECT_STDERR=${regex}")

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 # Runs one CLI command and checks its exit code and stderr, because ctest alone cannot check both
 # (PASS_REGULAR_EXPRESSION ignores the exit code). Called as:
-#   cmake -DCLI=<hbvh> -DARGS=<;-list> -DEXPECT_EXIT=<n> [-DEXPECT_STDERR=<regex>] [-DSTDIN=<file>] -P expect.cmake
+#   cmake -DCLI=<hbvh> -DARGS=<arguments separated by |> -DEXPECT_EXIT=<n> [-DEXPECT_STDERR=<regex>] [-DSTDIN=<file>] -P expect.cmake
+string(REPLACE "|" ";" ARGS "${ARGS}")
 if(DEFINED STDIN)
   set(input INPUT_FILE ${STDIN})
 endif()
