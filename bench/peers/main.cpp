@@ -361,5 +361,13 @@ int main(int argc, char** argv) {
                hbvh::to_string(pick_algorithm()));
     for (const Object& object : load_objects()) run_object(object, options, rows, builds);
     print(builds, rows, options);
+    // A disagreement beyond the tolerance means one of the three is wrong: fail, so that scripts notice.
+    std::uint64_t disagreements = 0;
+    for (const Row& row : rows)
+        disagreements += row.bullet.peer_only + row.bullet.hbvh_only + row.fcl.peer_only + row.fcl.hbvh_only;
+    if (disagreements > 0) {
+        fmt::print(stderr, "hbvh_peers: {} pair disagreements beyond the tolerance\n", disagreements);
+        return 1;
+    }
     return 0;
 }
