@@ -1,0 +1,60 @@
+# SPDX-License-Identifier: MIT
+# CLI smoke tests: `hbvh build` on bad and degenerate inputs (tests/cli/inputs/), checking the exit code
+# and the message on stderr, plus the guarantee that a failed build never damages an existing output.
+# docs/bad-input.md lists the same inputs with timings (tools/bad_input.sh), including slow ones left out here.
+if(NOT TARGET hbvh_cli)
+  return()
+endif()
+set(HBVH_CLI_INPUTS ${CMAKE_CURRENT_LIST_DIR}/inputs)
+set(HBVH_CLI_OUT ${CMAKE_CURRENT_BINARY_DIR}/cli)
+file(MAKE_DIRECTORY ${HBVH_CLI_OUT})
+
+# hbvh_cli_test(<name> <exit code> <stderr regex or ""> <cli arguments...>)
+function(hbvh_cli_test name exit_code regex)
+  string(JOIN "|" args ${ARGN})  # a list cannot pass through -D intact; expect.cmake splits it again
+  set(expect_stderr "")
+  if(NOT regex STREQUAL "")
+    set(expect_stderr "-DEXPECT_STDERR=${regex}")
+  endif()
+  add_test(NAME cli.${name}
+           COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> "-DARGS=${args}" -DEXPECT_EXIT=${exit_code}
+                   ${expect_stderr} -P ${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+endfunction()
+
+# Rejected input: exit 1 and a message naming the file and line.
+function(hbvh_cli_rejects input regex)
+  get_filename_component(stem ${input} NAME_WE)
+  hbvh_cli_test(rejects.${stem} 1 "${regex}" build ${HBVH_CLI_INPUTS}/${input} -o ${HBVH_CLI_OUT}/${stem}.out.xml)
+endfunction()
+hbvh_cli_rejects(malformed.xml "malformed.xml:1: malformed XML")
+hbvh_cli_rejects(unknown_type.xml "unknown_type.xml:1: unknown volume type \"cone\"")
+hbvh_cli_rejects(missing_number.xml "missing_number.xml:1: .*pos")
+hbvh_cli_rejects(extra_number.xml "extra_number.xml:1: .*pos")
+hbvh_cli_rejects(not_a_number.xml "not_a_number.xml:1: .*pos")
+hbvh_cli_rejects(zero_size.xml "zero_size.xml:1: .*width")
+hbvh_cli_rejects(negative_size.xml "negative_size.xml:1: .*depth")
+hbvh_cli_rejects(negative_radius.xml "negative_radius.xml:1: .*radius")
+hbvh_cli_rejects(nan.xml "nan.xml:1: .*pos")
+hbvh_cli_rejects(infinity.xml "infinity.xml:1: .*radius")
+hbvh_cli_rejects(not_rotation.xml "not_rotation.xml:1: attribute 'orientation' is not a rotation matrix")
+hbvh_cli_rejects(reflection.xml "reflection.xml:1: attribute 'orientation' is a reflection")
+hbvh_cli_rejects(empty.xml "empty.xml:1: file is empty")
+hbvh_cli_rejects(zero_radius.xml "zero_radius.xml:1: attribute .radius. must be > 0")
+hbvh_cli_rejects(no_volumes.xml "no_volumes.xml:1: ")
+hbvh_cli_rejects(unknown_attribute.xml "unknown_attribute.xml:1: unknown attribute 'colour'")
+hbvh_cli_rejects(wrong_root.xml "wrong_root.xml:1: expected <hierarchy>")
+hbvh_cli_rejects(zero_direction.xml "zero_direction.xml:1: attribute 'direction' must not be the zero vector")
+
+# Degenerate but valid geometry: accepted, exit 0.
+foreach(input one_primitive duplicates flat_boxes huge tiny mixed_scale)
+  hbvh_cli_test(accepts.${input} 0 "" build ${HBVH_CLI_INPUTS}/${input}.xml -o ${HBVH_CLI_OUT}/${input}.out.xml)
+endforeach()
+
+# Usage errors: exit 2 (bad arguments) or 1 (bad input file).
+hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-not-exist.xml -o ${HBVH_CLI_OUT}/x.xml)
+hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              -a no-such-builder -o ${HBVH_CLI_OUT}/x.xml)
+
+add_test(NAME cli.atomic_output
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
+                 -DWORK=${HBVH_CLI_OUT}/atomic -P ${CMAKE_CURRENT_LIST_DIR}/atomic_output.cmake)
