@@ -58,3 +58,9 @@ hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/
 add_test(NAME cli.atomic_output
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
                  -DWORK=${HBVH_CLI_OUT}/atomic -P ${CMAKE_CURRENT_LIST_DIR}/atomic_output.cmake)
+
+# hbvh compare's gap to the optimum and hbvh build's proven bound (every builder on the chair: tens of seconds).
+add_test(NAME cli.compare_gap
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
+                 -P ${CMAKE_CURRENT_LIST_DIR}/compare_gap.cmake)
+set_tests_properties(cli.compare_gap PROPERTIES TIMEOUT 900)
