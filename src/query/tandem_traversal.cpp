@@ -49,6 +49,9 @@ void enclosing_sphere(const BoundingVolume& bv, Vec3& center, double& radius) {
     radius *= 1.0 + sphere_padding;
 }
 
+// The traversal reads one node per test: keep it compact (docs/queries.md, "Query layout").
+static_assert(sizeof(QueryNode) == 152);
+
 constexpr bool is_box(BvType type) { return type == BvType::aabb || type == BvType::obb; }
 
 /// One of b's nodes, brought into a's frame lazily: the centre at once (9 multiply-adds, enough for the

@@ -28,7 +28,7 @@ struct CollideResult {
     std::uint64_t nodes_visited = 0;    ///< Node pairs found overlapping and then expanded or reported.
 };
 
-/// One node of a QueryTree: the hot data of the traversal, 160 bytes. Same indices as the Bvh it came
+/// One node of a QueryTree: the hot data of the traversal, 152 bytes. Same indices as the Bvh it came
 /// from; everything in the Bvh's model frame. The exact BV lives in QueryTree::volume(i) (cold).
 struct QueryNode {
     Vec3 center;                    ///< Box / sphere centre, capsule midpoint; also the enclosing sphere's centre.
