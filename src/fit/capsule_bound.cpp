@@ -1,0 +1,71 @@
+// SPDX-License-Identifier: MIT
+// capsule_volume_lower_bound: diameter and smallest in-plane widths of the set (see the header's proof).
+#include "capsule_bound.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "hull_2d.hpp"
+
+namespace hbvh::detail {
+namespace {
+
+/// Smallest width of a convex polygon (counter-clockwise, no repeated points): attained perpendicular to
+/// one of its edges, so the widths across the edges are the only ones tried. O(h^2); h stays small.
+double min_width(const std::vector<Eigen::Vector2d>& hull) {
+    if (hull.size() < 3) return 0.0;  // a segment or a point has no width
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+        const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
+        const double length = edge.norm();
+        if (!(length > 0.0)) continue;
+        const Eigen::Vector2d normal(-edge.y() / length, edge.x() / length);
+        double far = 0.0;
+        for (const Eigen::Vector2d& p : hull) far = std::max(far, std::abs((p - hull[i]).dot(normal)));
+        best = std::min(best, far);
+    }
+    return std::isfinite(best) ? best : 0.0;
+}
+
+}  // namespace
+
+double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes) {
+    if (proxy.spheres.empty()) return 0.0;
+    // Relative to one centre, so that rounding scales with the set's size, not its distance from the origin.
+    const Vec3 origin = proxy.spheres.front().center;
+    double min_radius = std::numeric_limits<double>::infinity();
+    double max_radius = 0.0;
+    double diameter = 0.0;
+    for (std::size_t i = 0; i < proxy.spheres.size(); ++i) {
+        const Sphere& a = proxy.spheres[i];
+        min_radius = std::min(min_radius, a.radius);
+        max_radius = std::max(max_radius, a.radius);
+        diameter = std::max(diameter, 2.0 * a.radius);
+        for (std::size_t j = i + 1; j < proxy.spheres.size(); ++j) {
+            const Sphere& b = proxy.spheres[j];
+            diameter = std::max(diameter, (a.center - b.center).norm() + a.radius + b.radius);
+        }
+    }
+
+    // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
+    // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
+    double radius = max_radius;
+    std::vector<Eigen::Vector2d> projected;
+    projected.reserve(proxy.hull_points.size());
+    for (const Mat3& frame : planes)
+        for (int k = 0; k < 3; ++k) {
+            const Vec3 u = frame.col((k + 1) % 3);
+            const Vec3 v = frame.col((k + 2) % 3);
+            projected.clear();
+            for (const Vec3& p : proxy.hull_points) projected.emplace_back((p - origin).dot(u), (p - origin).dot(v));
+            radius = std::max(radius, 0.5 * min_width(hull_2d(projected)) + min_radius);
+        }
+
+    const double length = std::max(0.0, diameter - 2.0 * radius);
+    return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+}
+
+}  // namespace hbvh::detail
