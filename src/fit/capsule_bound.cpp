@@ -3,6 +3,7 @@
 #include "capsule_bound.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -30,9 +31,24 @@ double min_width(const std::vector<Eigen::Vector2d>& hull) {
     return std::isfinite(best) ? best : 0.0;
 }
 
+/// Normals of the planes tried in a frame: its axes, and the diagonals of its faces and of the cube. For a
+/// box-like set with sides a >= b >= c along the frame, the plane containing a and the diagonal of b and
+/// c has smallest width min(a, (b + c) / sqrt 2), close to the sqrt(b^2 + c^2) a capsule along a needs;
+/// the frame's own planes only give b.
+const std::array<Vec3, 13>& plane_normals() {
+    static const std::array<Vec3, 13> normals = [] {
+        std::array<Vec3, 13> n{Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(0, 1, 1),  Vec3(0, 1, -1),
+                               Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(1, 1, 0),  Vec3(1, -1, 0), Vec3(1, 1, 1),
+                               Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(-1, 1, 1)};
+        for (Vec3& v : n) v.normalize();
+        return n;
+    }();
+    return normals;
+}
+
 }  // namespace
 
-double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes) {
+double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes, double enough) {
     if (proxy.spheres.empty()) return 0.0;
     // Relative to one centre, so that rounding scales with the set's size, not its distance from the origin.
     const Vec3 origin = proxy.spheres.front().center;
@@ -50,22 +66,28 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
         }
     }
 
+    auto volume_at = [&](double radius) {
+        const double length = std::max(0.0, diameter - 2.0 * radius);
+        return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+    };
     // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
     // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
     double radius = max_radius;
     std::vector<Eigen::Vector2d> projected;
     projected.reserve(proxy.hull_points.size());
     for (const Mat3& frame : planes)
-        for (int k = 0; k < 3; ++k) {
-            const Vec3 u = frame.col((k + 1) % 3);
-            const Vec3 v = frame.col((k + 2) % 3);
+        for (const Vec3& local_normal : plane_normals()) {
+            const Mat3 basis = frame_from_axis(frame * local_normal);
             projected.clear();
-            for (const Vec3& p : proxy.hull_points) projected.emplace_back((p - origin).dot(u), (p - origin).dot(v));
+            for (const Vec3& p : proxy.hull_points) {
+                const Vec3 d = p - origin;
+                projected.emplace_back(d.dot(basis.col(1)), d.dot(basis.col(2)));
+            }
             radius = std::max(radius, 0.5 * min_width(hull_2d(projected)) + min_radius);
+            // The bound only grows from here; once it is enough the other planes cannot change the answer.
+            if (volume_at(radius) >= enough) return volume_at(radius);
         }
-
-    const double length = std::max(0.0, diameter - 2.0 * radius);
-    return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+    return volume_at(radius);
 }
 
 }  // namespace hbvh::detail

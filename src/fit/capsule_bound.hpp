@@ -3,6 +3,7 @@
 // skip the (expensive) capsule fitter when a kind it already has is smaller.
 #pragma once
 
+#include <limits>
 #include <span>
 
 #include "frames.hpp"
@@ -16,6 +17,9 @@ namespace hbvh::detail {
 ///  * every plane P through the origin contains a direction u perpendicular to the capsule's axis, and
 ///    the capsule's width along such a u is 2r, so 2r >= the smallest width of the set along P;
 ///  * the volume pi r^2 L + 4/3 pi r^3 >= pi r^2 max(0, D - 2r) + 4/3 pi r^3, which grows with r.
-[[nodiscard]] double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes);
+/// The planes are tried in order and the search stops once the bound reaches `enough` (a caller that only
+/// asks "can a capsule beat this?" then pays for few planes).
+[[nodiscard]] double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes,
+                                                double enough = std::numeric_limits<double>::infinity());
 
 }  // namespace hbvh::detail

@@ -23,8 +23,8 @@ bool capsule_cannot_win(const detail::FitContext& context, std::span<const Mat3>
     // The bound is computed in rounded arithmetic from coordinates relative to the set; this margin is
     // far above that rounding, so a skip never depends on it.
     constexpr double rounding_margin = 1e-6;
-    const double bound = policy.weight_of(BvType::capsule) * detail::capsule_volume_lower_bound(context.proxy, planes);
-    return bound * (1.0 - rounding_margin) >= best_cost;
+    const double scale = policy.weight_of(BvType::capsule) * (1.0 - rounding_margin);
+    return scale * detail::capsule_volume_lower_bound(context.proxy, planes, best_cost / scale) >= best_cost;
 }
 
 }  // namespace
@@ -65,8 +65,8 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
 
     std::optional<BoundingVolume> best;
     double best_cost = std::numeric_limits<double>::infinity();
-    // The cross-sections for the capsule bound: the world axes, and the OBB's once it is fitted (a tight
-    // box's axes give the strongest bound).
+    // The cross-sections for the capsule bound: the OBB's axes once it is fitted (a tight box's axes give
+    // the strongest bound, so they go first), then the world axes.
     std::vector<Mat3> bound_planes{Mat3::Identity()};
     for (BvType type : all_bv_types) {
         if (!policy.is_allowed(type)) continue;
@@ -81,7 +81,7 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
             HBVH_ASSERT(false);
             return fit_aabb(spheres);
         }();
-        if (const Obb* box = std::get_if<Obb>(&candidate)) bound_planes.push_back(box->rotation);
+        if (const Obb* box = std::get_if<Obb>(&candidate)) bound_planes.insert(bound_planes.begin(), box->rotation);
         const double candidate_cost = policy.weighted_volume(candidate);
         // Strict '<' keeps the earlier (simpler) kind on ties: AABB before OBB before sphere before capsule.
         if (!best || candidate_cost < best_cost) {
