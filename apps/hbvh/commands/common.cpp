@@ -15,7 +15,9 @@
 
 namespace hbvh::cli {
 
-Result<Model> load_model(const std::string& path, const std::string& format) {
+namespace {
+/// The file as a Model, without checks across primitives (load_model adds those).
+Result<Model> read_model(const std::string& path, const std::string& format) {
     // A plain mesh (no UBX_/USP_/UCP_/UCX_ pieces) is imported only on request: one fitted primitive per
     // mesh node is a guess at the author's intent, not a reading of it.
     if (format == "mesh-nodes") {
@@ -57,6 +59,16 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
     if (!imported) return imported.error();
     if (imported->primitives.empty()) return Error{"the file holds no collision primitives", path};
     return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
+}
+}  // namespace
+
+Result<Model> load_model(const std::string& path, const std::string& format) {
+    Result<Model> model = read_model(path, format);
+    if (!model) return model;
+    // Refused here rather than in build() so that the message names the file.
+    if (Status finite = check_finite_extent(model->primitives); !finite)
+        return Error{finite.error().message, path == "-" ? "<stdin>" : path};
+    return model;
 }
 
 Status write_output(const std::string& path, const std::string& content) {
