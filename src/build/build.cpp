@@ -72,13 +72,20 @@ std::string format_cost(double value) {
 
 Result<Bvh> build_one(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options);
 
-/// `auto`: every member of auto_portfolio(n) builds a tree, the cheapest under Eq. 2 (first in the list on
-/// ties) wins, and treelet refinement polishes it up to auto_refine_max_primitives.
+/// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
+/// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
+/// comparison (refinement from different starts ends in different local optima, docs/treelets.md §3);
+/// above, up to auto_refine_max_primitives, only the winner is.
 Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildOptions& options) {
     const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
     const std::vector<Algorithm> members = auto_portfolio(primitives.size());
+    const bool refine_any = members.front() != Algorithm::optimal &&
+                            (options.refine || primitives.size() <= auto_refine_max_primitives);
+    const bool refine_each = refine_any && primitives.size() <= auto_refine_each_max_primitives;
     std::optional<Bvh> best;
     BuildReport best_report;
+    TreeletReport best_treelets;
     Algorithm winner = members.front();
     double best_cost = 0.0;
     std::string costs;
@@ -89,33 +96,38 @@ Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildOptions
         member_options.refine = false;
         Result<Bvh> built = build_one(primitives, member, member_options);
         if (!built) return built;
-        const double member_cost = cost(built.value(), options.policy);
+        Bvh tree = std::move(built.value());
+        double member_cost = cost(tree, options.policy);
         if (!costs.empty()) costs += ", ";
         costs += std::string(to_string(member)) + " " + format_cost(member_cost);
+        TreeletReport treelets;
+        if (refine_each) {
+            tree = refine_treelets(tree, options.policy, treelet_options_within(options, elapsed()), &treelets);
+            member_cost = treelets.cost_after;
+            costs += " -> " + format_cost(member_cost);
+        }
         if (!best || member_cost < best_cost) {
-            best = std::move(built.value());
+            best = std::move(tree);
             best_cost = member_cost;
             best_report = std::move(member_report);
+            best_treelets = treelets;
             winner = member;
         }
     }
+    if (refine_any && !refine_each)
+        *best = refine_treelets(*best, options.policy, treelet_options_within(options, elapsed()), &best_treelets);
     if (options.report != nullptr) {
         *options.report = std::move(best_report);
         if (members.size() > 1)
             options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, portfolio " +
-                                            costs + "; kept " + std::string(to_string(winner)));
+                                            costs + (refine_each ? " (each refined)" : "") + "; kept " +
+                                            std::string(to_string(winner)));
         else
             options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
                                             std::string(to_string(winner)));
+        if (refine_any) note_treelets(*options.report, best_treelets);
     }
-    const bool refine = winner != Algorithm::optimal &&
-                        (options.refine || primitives.size() <= auto_refine_max_primitives);
-    if (!refine) return std::move(*best);
-    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    TreeletReport treelets;
-    Bvh refined = refine_treelets(*best, options.policy, treelet_options_within(options, elapsed), &treelets);
-    if (options.report != nullptr) note_treelets(*options.report, treelets);
-    return refined;
+    return std::move(*best);
 }
 }  // namespace
 
@@ -134,7 +146,7 @@ std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
     if (primitive_count <= auto_optimal_max_primitives) return {Algorithm::optimal};
     if (primitive_count <= auto_exact_max_primitives)
         return {Algorithm::bnb_exact, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split,
-                Algorithm::merge};
+                Algorithm::merge, Algorithm::scale};
     if (primitive_count <= auto_portfolio_max_primitives)
         return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split};
     return {Algorithm::scale};
