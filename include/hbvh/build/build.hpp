@@ -85,15 +85,18 @@ struct BuildOptions {
 /// optimal subset DP alone (~1 s at 10 primitives, doubling per primitive). Up to
 /// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge and scale
 /// (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
-/// none wins everywhere, docs/results.md §1). Up to auto_portfolio_max_primitives: the cheapest of scale,
-/// insertion-haber, insertion and split. Above: scale alone (split took 18 s at 20 000 primitives, scale 6 s).
+/// none wins everywhere, docs/results.md §1). Up to auto_insertion_max_primitives: the cheapest of scale,
+/// insertion-haber, insertion and split; up to auto_portfolio_max_primitives: of scale and split (at 1000
+/// primitives the insertions took 5-7 s, split 1.5 s, scale 0.5 s). Above: scale alone (split took 18 s
+/// at 20 000 primitives, scale 6 s).
 /// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
 /// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
 inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
 inline constexpr std::uint32_t auto_exact_max_primitives = 24;
+inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
 inline constexpr std::uint32_t auto_portfolio_max_primitives = 2000;
-inline constexpr std::uint32_t auto_refine_each_max_primitives = 64;
-inline constexpr std::uint32_t auto_refine_max_primitives = 500;
+inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
+inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 
 /// The builders `auto` tries for `primitive_count` primitives, in tie-break order (the first wins ties).
 [[nodiscard]] std::vector<Algorithm> auto_portfolio(std::size_t primitive_count);
