@@ -3,13 +3,16 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "hbvh/build/optimal.hpp"
 #include "hbvh/build/two_level.hpp"
+#include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
 namespace {
@@ -25,7 +28,7 @@ constexpr std::array registry{
     AlgorithmInfo{Algorithm::split, "split", "Mueller et al. top-down split at the cheapest sorted cut on x, y or z (survey 2.2)"},
     AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)"},
     AlgorithmInfo{Algorithm::scale, "scale", "10^3-10^6 primitives: bottom-up levels, kNN candidates, exact partition per Morton window, multi-threaded (docs/scale.md)"},
-    AlgorithmInfo{Algorithm::automatic, "auto", "by size: optimal up to 10 primitives, bnb-exact up to 24, scale above (measured: docs/scale.md)"},
+    AlgorithmInfo{Algorithm::automatic, "auto", "by size: optimal up to 10 primitives; above, the cheapest of a portfolio of builders, then treelet refinement (docs/treelets.md)"},
 };
 
 /// bnb-exact's options with a whole-build time limit spread over its solver calls: the levels number
@@ -73,10 +76,106 @@ Status check_finite_extent(std::span<const Primitive> primitives) {
     return Ok{};
 }
 
-Algorithm auto_choice(std::size_t primitive_count) {
-    if (primitive_count <= auto_optimal_max_primitives) return Algorithm::optimal;
-    if (primitive_count <= auto_exact_max_primitives) return Algorithm::bnb_exact;
-    return Algorithm::scale;
+namespace {
+TreeletOptions treelet_options_within(const BuildOptions& options, double elapsed_seconds) {
+    TreeletOptions treelets = options.treelets;
+    if (options.time_limit_seconds > 0.0) {
+        // Whatever the builders left; a token amount when they used it all, so the call returns at once.
+        const double left = options.time_limit_seconds - elapsed_seconds;
+        treelets.time_limit_seconds = left > 0.0 ? left : 1e-9;
+        if (options.treelets.time_limit_seconds > 0.0)
+            treelets.time_limit_seconds = std::min(treelets.time_limit_seconds, options.treelets.time_limit_seconds);
+    }
+    return treelets;
+}
+
+std::string format_cost(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", value);
+    return text;
+}
+
+Result<Bvh> build_one(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options);
+
+/// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
+/// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
+/// comparison (refinement from different starts ends in different local optima, docs/treelets.md §3);
+/// above, up to auto_refine_max_primitives, only the winner is.
+Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildOptions& options) {
+    const auto start = std::chrono::steady_clock::now();
+    auto elapsed = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
+    const std::vector<Algorithm> members = auto_portfolio(primitives.size());
+    const bool refine_any = members.front() != Algorithm::optimal &&
+                            (options.refine || primitives.size() <= auto_refine_max_primitives);
+    const bool refine_each = refine_any && primitives.size() <= auto_refine_each_max_primitives;
+    std::optional<Bvh> best;
+    BuildReport best_report;
+    TreeletReport best_treelets;
+    Algorithm winner = members.front();
+    double best_cost = 0.0;
+    std::string costs;
+    for (Algorithm member : members) {
+        BuildReport member_report;
+        BuildOptions member_options = options;
+        member_options.report = options.report != nullptr ? &member_report : nullptr;
+        member_options.refine = false;
+        Result<Bvh> built = build_one(primitives, member, member_options);
+        if (!built) return built;
+        Bvh tree = std::move(built.value());
+        double member_cost = cost(tree, options.policy);
+        if (!costs.empty()) costs += ", ";
+        costs += std::string(to_string(member)) + " " + format_cost(member_cost);
+        TreeletReport treelets;
+        if (refine_each) {
+            tree = refine_treelets(tree, options.policy, treelet_options_within(options, elapsed()), &treelets);
+            member_cost = treelets.cost_after;
+            costs += " -> " + format_cost(member_cost);
+        }
+        if (!best || member_cost < best_cost) {
+            best = std::move(tree);
+            best_cost = member_cost;
+            best_report = std::move(member_report);
+            best_treelets = treelets;
+            winner = member;
+        }
+    }
+    if (refine_any && !refine_each)
+        *best = refine_treelets(*best, options.policy, treelet_options_within(options, elapsed()), &best_treelets);
+    if (options.report != nullptr) {
+        *options.report = std::move(best_report);
+        if (members.size() > 1)
+            options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, portfolio " +
+                                            costs + (refine_each ? " (each refined)" : "") + "; kept " +
+                                            std::string(to_string(winner)));
+        else
+            options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
+                                            std::string(to_string(winner)));
+        if (refine_any) note_treelets(*options.report, best_treelets);
+    }
+    return std::move(*best);
+}
+}  // namespace
+
+void note_treelets(BuildReport& report, const TreeletReport& treelets) {
+    report.notes.push_back("treelets: " + std::to_string(treelets.passes) + " passes, " +
+                           std::to_string(treelets.replaced) + " of " + std::to_string(treelets.treelets) +
+                           " treelets replaced, " + std::to_string(treelets.fits) + " fits, cost " +
+                           format_cost(treelets.cost_before) + " -> " + format_cost(treelets.cost_after) +
+                           (treelets.time_limit_hit ? " (time limit hit)" : ""));
+    if (treelets.time_limit_hit) report.budget_hit = true;
+}
+
+Algorithm auto_choice(std::size_t primitive_count) { return auto_portfolio(primitive_count).front(); }
+
+std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
+    if (primitive_count <= auto_optimal_max_primitives) return {Algorithm::optimal};
+    if (primitive_count <= auto_exact_max_primitives)
+        return {Algorithm::bnb_exact, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split,
+                Algorithm::merge, Algorithm::scale};
+    if (primitive_count <= auto_insertion_max_primitives)
+        return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split};
+    if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::scale, Algorithm::split};
+    return {Algorithm::scale};
 }
 
 std::span<const AlgorithmInfo> algorithms() { return registry; }
@@ -96,6 +195,19 @@ std::string_view to_string(Algorithm algorithm) {
 Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
     if (Status finite = check_finite_extent(primitives); !finite) return finite.error();
+    if (algorithm == Algorithm::automatic) return build_auto(primitives, options);
+    const auto start = std::chrono::steady_clock::now();
+    Result<Bvh> built = build_one(primitives, algorithm, options);
+    if (!built || !options.refine) return built;
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    TreeletReport treelets;
+    Bvh refined = refine_treelets(built.value(), options.policy, treelet_options_within(options, elapsed), &treelets);
+    if (options.report != nullptr) note_treelets(*options.report, treelets);
+    return refined;
+}
+
+namespace {
+Result<Bvh> build_one(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
     switch (algorithm) {
         case Algorithm::two_level: return build_two_level(primitives, options.policy);
         case Algorithm::bnb_tightest:
@@ -114,16 +226,10 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
         case Algorithm::obb_tree: return build_obb_tree(primitives, options.policy, options.obb_tree);
         case Algorithm::scale:
             return build_scale(primitives, options.policy, scale_options_within(options), options.report);
-        case Algorithm::automatic: {
-            const Algorithm chosen = auto_choice(primitives.size());
-            Result<Bvh> built = build(primitives, chosen, options);
-            if (options.report != nullptr)
-                options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
-                                                std::string(to_string(chosen)));
-            return built;
-        }
+        case Algorithm::automatic: return build_auto(primitives, options);
     }
     return Error{"unknown algorithm", "", 0};
 }
+}  // namespace
 
 }  // namespace hbvh

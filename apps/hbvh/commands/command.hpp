@@ -56,6 +56,8 @@ struct BuilderFlags {
     std::string types = "aabb,obb,sphere,capsule";
     std::string type_weights;
     double time_limit_seconds = 0.0;  ///< --time-limit: anytime builders return the best found by then.
+    bool refine = false;              ///< --refine: treelet refinement after any builder.
+    std::uint32_t treelet_units = TreeletOptions{}.max_units;  ///< --treelet-units.
     void add_to(CLI::App& command);
     /// The algorithm and options, or a usage Error.
     [[nodiscard]] Result<std::pair<Algorithm, BuildOptions>> resolve() const;

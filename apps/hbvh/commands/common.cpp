@@ -98,6 +98,12 @@ void BuilderFlags::add_to(CLI::App& command) {
     command.add_option("--time-limit", time_limit_seconds,
                        "Seconds the build may take (0 = no limit); scale and bnb-exact return their best by then")
         ->check(CLI::NonNegativeNumber);
+    command.add_flag("--refine", refine,
+                     "Refine the builder's tree by optimal treelet re-arrangement (never costlier; docs/treelets.md)");
+    command.add_option("--treelet-units", treelet_units,
+                       "Subtrees per treelet for --refine and auto (2^m fits each)")
+        ->capture_default_str()
+        ->check(CLI::Range(3u, 12u));
 }
 
 Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
@@ -112,6 +118,8 @@ Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
     BuildOptions options;
     options.policy = policy.value();
     options.time_limit_seconds = time_limit_seconds;
+    options.refine = refine;
+    options.treelets.max_units = treelet_units;
     return std::pair{*chosen, options};
 }
 

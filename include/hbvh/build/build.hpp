@@ -8,6 +8,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <vector>
 
 #include "hbvh/build/bnb_exact.hpp"
 #include "hbvh/build/bottom_up_merge.hpp"
@@ -19,6 +20,7 @@
 #include "hbvh/build/report.hpp"
 #include "hbvh/build/scale.hpp"
 #include "hbvh/build/top_down_split.hpp"
+#include "hbvh/build/treelet.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
@@ -37,7 +39,7 @@ enum class Algorithm {
     split,
     obb_tree,
     scale,
-    automatic,  ///< "auto": optimal, bnb-exact or scale by input size (auto_choice).
+    automatic,  ///< "auto": optimal, or the cheapest of a portfolio then treelet refinement (auto_portfolio).
 };
 
 /// One row of the registry: CLI name and a one-line summary.
@@ -65,27 +67,48 @@ struct BuildOptions {
     SplitOptions split;              ///< For Algorithm::split.
     ObbTreeOptions obb_tree;         ///< For Algorithm::obb_tree.
     ScaleOptions scale;              ///< For Algorithm::scale (time limit and progress come from below).
+    /// Run refine_treelets on the builder's tree (CLI --refine). `auto` refines up to
+    /// auto_refine_max_primitives whatever this says, and at any size when it is true.
+    bool refine = false;
+    TreeletOptions treelets;         ///< For the refinement (time limit: what the build left, see below).
     /// Wall-clock limit for the whole build in seconds; 0 = none. scale and bnb-exact (and auto) pass it to
     /// their solvers as budgets and return the best hierarchy found; BuildReport::budget_hit tells.
+    /// `auto` passes it to each portfolio member (the heuristic members take milliseconds); treelet
+    /// refinement gets what is left and stops between treelets when it runs out.
     double time_limit_seconds = 0.0;
     /// Called with the fraction done (0..1] as the build progresses (scale: per level), from the calling
     /// thread. Empty: no calls. The library never prints; the CLI draws the bar.
     std::function<void(double fraction)> progress;
 };
 
-/// Input sizes at which `auto` switches builder: optimal up to auto_optimal_max_primitives, bnb-exact up to
-/// auto_exact_max_primitives, scale above. Chosen from measured times with every BV kind allowed
-/// (docs/scale.md §5): optimal takes ~1 s at 10 primitives and doubles per primitive; bnb-exact's O(n^3)
-/// Tightest candidates take seconds at 20 and minutes at 50, far from the ~2000 once hoped for.
+/// Input sizes at which `auto` changes strategy (auto_portfolio). Up to auto_optimal_max_primitives: the
+/// optimal subset DP alone (~1 s at 10 primitives, doubling per primitive). Up to
+/// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge and scale
+/// (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
+/// none wins everywhere, docs/results.md §1). Up to auto_insertion_max_primitives: the cheapest of scale,
+/// insertion-haber, insertion and split; up to auto_portfolio_max_primitives: of scale and split (at 1000
+/// primitives the insertions took 5-7 s, split 1.5 s, scale 0.5 s). Above: scale alone (split took 18 s
+/// at 20 000 primitives, scale 6 s).
+/// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
+/// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
 inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
 inline constexpr std::uint32_t auto_exact_max_primitives = 24;
+inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
+inline constexpr std::uint32_t auto_portfolio_max_primitives = 2000;
+inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
+inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 
-/// The builder `auto` uses for `primitive_count` primitives.
+/// The builders `auto` tries for `primitive_count` primitives, in tie-break order (the first wins ties).
+[[nodiscard]] std::vector<Algorithm> auto_portfolio(std::size_t primitive_count);
+/// The first member of auto_portfolio(primitive_count).
 [[nodiscard]] Algorithm auto_choice(std::size_t primitive_count);
 
 /// Ok when the primitives' world box has a finite volume; otherwise an Error (no file) saying the model
 /// must be scaled down. build() checks this first: Eq. 2 is meaningless once volumes overflow to infinity.
 [[nodiscard]] Status check_finite_extent(std::span<const Primitive> primitives);
+
+/// Appends a one-line summary of a treelet refinement to report.notes (and sets budget_hit on a time-out).
+void note_treelets(BuildReport& report, const TreeletReport& treelets);
 
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
 /// Returns an Error for an empty input.

@@ -1,0 +1,292 @@
+// SPDX-License-Identifier: MIT
+// Treelet refinement (docs/treelets.md), after Karras and Aila's treelet restructuring for ray-tracing
+// BVHs (HPG 2013), here with Eq. 2 as the cost and the subset DP of optimal.cpp as the exact solver.
+//
+// Why a treelet can be solved exactly: fix an inner node N and a set of m disjoint subtrees ("units")
+// that together cover N's primitives. Any tree over the units keeps each unit's internal cost, so its
+// Eq. 2 cost is a constant plus the sum over its new inner nodes of children x vol(BV of the primitives
+// below). That is exactly the problem solve_optimal_hierarchy solves with the units as its leaves, with
+// subset_volume[mask] = weighted volume of the BV over the primitives of the units in mask.
+#include "hbvh/build/treelet.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <bit>
+#include <chrono>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "hbvh/assert.hpp"
+#include "hbvh/build/optimal.hpp"
+#include "hbvh/fit/fit.hpp"
+#include "hbvh/tree/stats.hpp"
+
+namespace hbvh {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+/// A node of the mutable tree the refiner edits; ids are stable, replaced inner nodes become garbage.
+struct Item {
+    BoundingVolume volume;
+    std::vector<std::uint32_t> children;
+    std::uint32_t primitive = 0;
+};
+
+/// fit_best over one covered set and its weighted volume.
+struct Fitted {
+    BoundingVolume volume;
+    double weighted = 0.0;
+};
+
+/// FNV-1a over the sorted primitive indices of a covered set.
+struct CoveredHash {
+    std::size_t operator()(const std::vector<std::uint32_t>& key) const {
+        std::uint64_t h = 1469598103934665603ull;
+        for (std::uint32_t v : key) {
+            h ^= v;
+            h *= 1099511628211ull;
+        }
+        return static_cast<std::size_t>(h);
+    }
+};
+
+class Refiner {
+public:
+    Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options)
+        : primitives_(bvh.primitives), policy_(policy),
+          max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)) {
+        items_.reserve(bvh.nodes.size());
+        for (const Node& node : bvh.nodes) {
+            Item item{node.volume, {}, node.primitive};
+            for (std::uint32_t c = 0; c < node.child_count; ++c) item.children.push_back(node.first_child + c);
+            items_.push_back(std::move(item));
+        }
+    }
+
+    /// Inner nodes below the root (id 0), children before parents.
+    [[nodiscard]] std::vector<std::uint32_t> inner_postorder() const {
+        std::vector<std::uint32_t> order;
+        std::vector<std::pair<std::uint32_t, bool>> stack{{0u, false}};
+        while (!stack.empty()) {
+            const auto [id, visited] = stack.back();
+            stack.pop_back();
+            if (items_[id].children.empty()) continue;
+            if (visited) {
+                order.push_back(id);
+                continue;
+            }
+            stack.emplace_back(id, true);
+            for (auto it = items_[id].children.rbegin(); it != items_[id].children.rend(); ++it)
+                stack.emplace_back(*it, false);
+        }
+        return order;
+    }
+
+    /// Solves the treelet rooted at `root`; true when it was replaced by a strictly cheaper one.
+    bool refine_at(std::uint32_t root);
+
+    [[nodiscard]] Bvh finish() const;
+    [[nodiscard]] std::uint64_t fit_count() const { return fits_; }
+
+private:
+    [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {
+        std::vector<std::uint32_t> out;
+        std::vector<std::uint32_t> stack{id};
+        while (!stack.empty()) {
+            const Item& item = items_[stack.back()];
+            stack.pop_back();
+            if (item.children.empty()) out.push_back(item.primitive);
+            for (std::uint32_t child : item.children) stack.push_back(child);
+        }
+        std::sort(out.begin(), out.end());
+        return out;
+    }
+
+    const std::vector<Primitive>& primitives_;
+    const VolumePolicy& policy_;
+    std::uint32_t max_units_;
+    std::vector<Item> items_;
+    std::unordered_map<std::vector<std::uint32_t>, Fitted, CoveredHash> cache_;
+    std::uint64_t fits_ = 0;
+};
+
+bool Refiner::refine_at(std::uint32_t root) {
+    if (items_[root].children.size() > max_units_) return false;
+
+    // Stage 1: the treelet. Expand the frontier unit with the largest weighted volume (the first on ties)
+    // while the frontier stays within max_units: big volumes are where re-grouping pays most.
+    std::vector<std::uint32_t> frontier = items_[root].children;
+    std::vector<std::uint32_t> expanded{root};
+    for (;;) {
+        std::size_t chosen = frontier.size();
+        double largest = -1.0;
+        for (std::size_t i = 0; i < frontier.size(); ++i) {
+            const Item& item = items_[frontier[i]];
+            if (item.children.empty() || frontier.size() - 1 + item.children.size() > max_units_) continue;
+            const double weighted = policy_.weighted_volume(item.volume);
+            if (weighted > largest) {
+                largest = weighted;
+                chosen = i;
+            }
+        }
+        if (chosen == frontier.size()) break;
+        const std::uint32_t id = frontier[chosen];
+        expanded.push_back(id);
+        frontier.erase(frontier.begin() + static_cast<std::ptrdiff_t>(chosen));
+        frontier.insert(frontier.begin() + static_cast<std::ptrdiff_t>(chosen), items_[id].children.begin(),
+                        items_[id].children.end());
+    }
+    const auto units = static_cast<std::uint32_t>(frontier.size());
+    if (units < 3) return false;  // two units admit one tree only
+
+    // Stage 2: the current arrangement as masks over the units, and its cost.
+    std::unordered_map<std::uint32_t, std::uint32_t> mask_of;
+    for (std::uint32_t i = 0; i < units; ++i) mask_of[frontier[i]] = 1u << i;
+    double current = 0.0;
+    for (auto it = expanded.rbegin(); it != expanded.rend(); ++it) {  // children were expanded after parents
+        std::uint32_t mask = 0;
+        for (std::uint32_t child : items_[*it].children) mask |= mask_of.at(child);
+        mask_of[*it] = mask;
+        current += static_cast<double>(items_[*it].children.size()) * policy_.weighted_volume(items_[*it].volume);
+    }
+
+    // Stage 3: fit_best over the primitives of every union of two or more units. Covered sets recur
+    // across treelets and passes, so fits are cached by set; the missing ones are fitted in parallel,
+    // each depending on its set only, so the result does not depend on the thread count.
+    std::vector<std::vector<std::uint32_t>> unit_primitives(units);
+    for (std::uint32_t i = 0; i < units; ++i) unit_primitives[i] = covered(frontier[i]);
+    const std::uint32_t subsets = 1u << units;
+    std::vector<const Fitted*> fitted(subsets, nullptr);
+    std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> missing;
+    for (std::uint32_t mask = 1; mask < subsets; ++mask) {
+        if (std::popcount(mask) < 2) continue;
+        std::vector<std::uint32_t> key;
+        for (std::uint32_t i = 0; i < units; ++i)
+            if (mask >> i & 1u) key.insert(key.end(), unit_primitives[i].begin(), unit_primitives[i].end());
+        std::sort(key.begin(), key.end());
+        if (auto found = cache_.find(key); found != cache_.end())
+            fitted[mask] = &found->second;
+        else
+            missing.emplace_back(mask, std::move(key));
+    }
+    std::vector<Fitted> fresh(missing.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), 4),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                              FitInput input;
+                              for (std::uint32_t p : missing[j].second) input.add(primitives_[p].volume);
+                              BoundingVolume bv = fit_best(input.spheres, policy_, input.hint_axes);
+                              fresh[j].weighted = policy_.weighted_volume(bv);
+                              fresh[j].volume = std::move(bv);
+                          }
+                      });
+    fits_ += missing.size();
+    for (std::size_t j = 0; j < missing.size(); ++j) {
+        auto [it, inserted] = cache_.emplace(std::move(missing[j].second), std::move(fresh[j]));
+        HBVH_ASSERT(inserted);
+        fitted[missing[j].first] = &it->second;  // unordered_map never moves its elements
+    }
+
+    // Stage 4: the subset volumes. Where the current tree already has a node over a set and its BV is
+    // allowed and no larger than the fit, keep it: then the current arrangement is one of the DP's
+    // candidates at its current cost, so the optimum can only be cheaper.
+    std::vector<double> volume(subsets, 0.0);
+    std::vector<std::uint32_t> keep(subsets, 0);  // item id + 1 whose BV to keep, 0 = use the fit
+    for (std::uint32_t mask = 1; mask < subsets; ++mask)
+        if (fitted[mask] != nullptr) volume[mask] = fitted[mask]->weighted;
+    for (std::uint32_t id : expanded) {
+        const std::uint32_t mask = mask_of.at(id);
+        const BoundingVolume& bv = items_[id].volume;
+        const double weighted = policy_.weighted_volume(bv);
+        if (policy_.is_allowed(type_of(bv)) && weighted <= volume[mask]) {
+            volume[mask] = weighted;
+            keep[mask] = id + 1;
+        }
+    }
+    const OptimalPlan plan = solve_optimal_hierarchy(units, volume);
+    if (!(plan.cost < current * (1.0 - 1e-12))) return false;
+
+    // Stage 5: rebuild the treelet, children before parents. The root keeps its id so that its parent
+    // and the caller's postorder stay valid; the replaced inner nodes are left unreferenced.
+    std::vector<std::uint32_t> id_of(subsets, 0);
+    for (std::uint32_t i = 0; i < units; ++i) id_of[1u << i] = frontier[i];
+    for (auto it = plan.groups.rbegin(); it != plan.groups.rend(); ++it) {
+        const std::uint32_t mask = it->covered;
+        BoundingVolume bv = keep[mask] != 0 ? items_[keep[mask] - 1].volume : fitted[mask]->volume;
+        std::vector<std::uint32_t> children;
+        for (std::uint32_t child : it->children) children.push_back(id_of[child]);
+        if (mask == subsets - 1u) {
+            items_[root].volume = std::move(bv);
+            items_[root].children = std::move(children);
+            id_of[mask] = root;
+        } else {
+            items_.push_back({std::move(bv), std::move(children), 0});
+            id_of[mask] = static_cast<std::uint32_t>(items_.size() - 1);
+        }
+    }
+    return true;
+}
+
+Bvh Refiner::finish() const {
+    TreeAssembler assembler(primitives_);
+    std::vector<std::uint32_t> assembled(items_.size(), 0);
+    std::vector<std::pair<std::uint32_t, bool>> stack{{0u, false}};
+    while (!stack.empty()) {
+        const auto [id, visited] = stack.back();
+        stack.pop_back();
+        const Item& item = items_[id];
+        if (item.children.empty()) {
+            assembled[id] = assembler.add_leaf(item.primitive);
+        } else if (visited) {
+            std::vector<std::uint32_t> children;
+            for (std::uint32_t child : item.children) children.push_back(assembled[child]);
+            assembled[id] = assembler.add_group(children, item.volume);
+        } else {
+            stack.emplace_back(id, true);
+            for (std::uint32_t child : item.children) stack.emplace_back(child, false);
+        }
+    }
+    return std::move(assembler).finish(assembled[0]);
+}
+
+}  // namespace
+
+Bvh refine_treelets(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options,
+                    TreeletReport* report) {
+    const auto start = Clock::now();
+    TreeletReport local;
+    if (bvh.nodes.size() < 2) {
+        if (report != nullptr) *report = local;
+        return bvh;
+    }
+    local.cost_before = cost(bvh, policy);
+    Refiner refiner(bvh, policy, options);
+    for (std::uint32_t pass = 0; pass < options.max_passes && !local.time_limit_hit; ++pass) {
+        bool changed = false;
+        for (std::uint32_t id : refiner.inner_postorder()) {
+            if (options.time_limit_seconds > 0.0 &&
+                std::chrono::duration<double>(Clock::now() - start).count() > options.time_limit_seconds) {
+                local.time_limit_hit = true;
+                break;
+            }
+            ++local.treelets;
+            if (refiner.refine_at(id)) {
+                ++local.replaced;
+                changed = true;
+            }
+        }
+        ++local.passes;
+        if (!changed) break;
+    }
+    Bvh refined = refiner.finish();
+    local.fits = refiner.fit_count();
+    local.cost_after = cost(refined, policy);
+    if (report != nullptr) *report = local;
+    return refined;
+}
+
+}  // namespace hbvh
