@@ -31,7 +31,9 @@ for target in "${targets[@]}"; do
   [ -f "fuzz/dict/$target.dict" ] && dict=(-dict="fuzz/dict/$target.dict")
   echo "== fuzz_$target for ${seconds}s"
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb also caps single allocations (malloc_limit_mb).
-  if ! "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "${dict[@]}" \
+  # The outer timeout is a backstop: libFuzzer's own hang report can deadlock in its alarm handler (seen with
+  # clang 16 when the hang is inside an allocation), and CI must not wait forever.
+  if ! timeout -k 10 $((seconds + 60)) "$fuzzer" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "${dict[@]}" \
       -artifact_prefix="build-fuzz/artifacts-$target/" "$work" "fuzz/corpus/$target" \
       >"build-fuzz/fuzz_$target.log" 2>&1; then
     echo "fuzz_$target FAILED: see build-fuzz/fuzz_$target.log and build-fuzz/artifacts-$target/"
