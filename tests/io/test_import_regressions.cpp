@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: MIT
+// Regressions for importer bugs found by the fuzzers (fuzz/) and by the bad-input survey (docs/bad-input.md):
+// each input once crashed, hung or produced primitives that hbvh's own XML reader refuses.
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "hbvh/io/mesh_import.hpp"
+#include "hbvh/io/mjcf.hpp"
+#include "hbvh/io/xml.hpp"
+
+namespace hbvh {
+namespace {
+
+namespace fs = std::filesystem;
+
+/// A fresh folder for one test, removed at the end.
+class ScratchFolder {
+public:
+    explicit ScratchFolder(const std::string& name) : path_(fs::temp_directory_path() / ("hbvh_regression_" + name)) {
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~ScratchFolder() {
+        std::error_code ignored;
+        fs::remove_all(path_, ignored);
+    }
+    std::string write(const std::string& name, const std::string& content) const {
+        const fs::path file = path_ / name;
+        std::ofstream(file, std::ios::binary) << content;
+        return file.string();
+    }
+
+private:
+    fs::path path_;
+};
+
+/// Everything imported must read back through the survey format (what `hbvh convert` then `hbvh build` do).
+void expect_round_trip(const ImportResult& imported) {
+    const Result<XmlModel> again = read_xml_string(write_primitives_xml(imported.primitives), "round trip");
+    ASSERT_TRUE(again.has_value()) << again.error().to_string();
+    EXPECT_EQ(again->primitives.size(), imported.primitives.size());
+}
+
+// assimp 5.2 looped and allocated for minutes on a PLY header declaring far more elements than the file holds.
+TEST(ImportRegressions, PlyHeaderCountsBeyondTheFileAreRefused) {
+    const ScratchFolder folder("ply_header");
+    const std::string path = folder.write(
+        "huge.ply", "ply\nformat ascii 1.0\nelement vertex 99999999999\nproperty float x\nend_header\n");
+    const Result<ImportResult> imported = import_mesh(path);
+    ASSERT_FALSE(imported.has_value());
+    EXPECT_EQ(imported.error().file, path);
+    EXPECT_EQ(imported.error().line, 5);
+    EXPECT_NE(imported.error().message.find("PLY header declares"), std::string::npos) << imported.error().message;
+
+    // Binary, counts that fit: still read (the check counts at least one byte per property).
+    const std::string binary_header = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+                                      "property float y\nproperty float z\nelement face 1\n"
+                                      "property list uchar int vertex_indices\nend_header\n";
+    std::string body(9 * sizeof(float), '\0');
+    const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 1};
+    std::memcpy(body.data(), corners, sizeof corners);
+    body += std::string(1, '\3');
+    const std::int32_t indices[3] = {0, 1, 2};
+    body.append(reinterpret_cast<const char*>(indices), sizeof indices);
+    MeshImportOptions per_mesh;
+    per_mesh.one_primitive_per_mesh = true;
+    const Result<ImportResult> triangle = import_mesh(folder.write("triangle.ply", binary_header + body), per_mesh);
+    ASSERT_TRUE(triangle.has_value()) << triangle.error().to_string();
+    EXPECT_EQ(triangle->primitives.size(), 1u);
+    // One byte short of the smallest possible body: refused.
+    const std::string short_header = "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty uchar x\n"
+                                     "property uchar y\nend_header\n";
+    EXPECT_FALSE(import_mesh(folder.write("short.ply", short_header + std::string(7, '\1'))).has_value());
+}
+
+// assimp 5.2 looped forever looking for the end of a PLY header that has none (found by fuzz_ply).
+TEST(ImportRegressions, PlyHeaderWithoutEndIsRefused) {
+    const ScratchFolder folder("ply_no_end");
+    const std::string path = folder.write("open.ply", "ply\nformat ascii 1.0\ncomment a tetrahedron\n"
+                                                      "elemen int vertex_indir7s\ne\n1 0 ader\n0 0 0\n1 0 0\n"
+                                                      "0 1 0\n0 0 1 z\nelement face 4\nprope3\n3 1 2 3\n");
+    const Result<ImportResult> imported = import_mesh(path);
+    ASSERT_FALSE(imported.has_value());
+    EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+}
+
+// Coincident, collinear or coplanar collision pieces fitted zero-size volumes (a radius-0 sphere, a box of height
+// 0), which `hbvh convert` wrote and every XML reader of hbvh then refused.
+TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
+    const ScratchFolder folder("degenerate_mesh");
+    const std::string path = folder.write("pieces.obj",
+                                          "o USP_point\nv 1 2 3\np 1\n"
+                                          "o UCP_line\nv 0 0 0\nv 0 0 1\nv 0 0 2\nl 2 3 4\n"
+                                          "o UBX_floor\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 5 6 7 8\n"
+                                          "o UCX_point\nv 4 4 4\nv 4 4 4\np 9\np 10\n"
+                                          "o UBX_crate\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 11 12 13\nf 11 12 14\n");
+    const Result<ImportResult> imported = import_mesh(path);
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    ASSERT_EQ(imported->primitives.size(), 1u);
+    EXPECT_EQ(imported->primitives[0].name, "UBX_crate");
+    expect_round_trip(*imported);
+    int skipped = 0;
+    for (const std::string& warning : imported->warnings) skipped += warning.find("skipped") != std::string::npos;
+    EXPECT_GE(skipped, 3) << "the single point, the line and the coincident pair each need a warning";
+    for (const char* name : {"USP_point", "UCP_line", "UCX_point"}) {
+        const bool named = std::any_of(imported->warnings.begin(), imported->warnings.end(),
+                                       [&](const std::string& w) { return w.find(name) != std::string::npos; });
+        EXPECT_TRUE(named) << name;
+    }
+}
+
+// <include file="/dev/zero"> read forever (and /dev/stdin waited for input): included files come from the model,
+// so only regular files are followed.
+TEST(ImportRegressions, MjcfIncludeOfADeviceOrFolderIsRefused) {
+    const ScratchFolder folder("mjcf_device");
+    for (const std::string target : {"/dev/zero", "."}) {
+        const std::string path = folder.write(
+            "model.xml", "<mujoco>\n  <include file=\"" + target + "\"/>\n  <worldbody><geom size=\"1\"/></worldbody>\n</mujoco>\n");
+        const Result<ImportResult> imported = import_mjcf(path);
+        ASSERT_FALSE(imported.has_value()) << target;
+        EXPECT_EQ(imported.error().line, 2) << target;
+        EXPECT_NE(imported.error().message.find("not a regular file"), std::string::npos) << imported.error().message;
+    }
+}
+
+}  // namespace
+}  // namespace hbvh
