@@ -92,12 +92,12 @@ bool has_positive_size(const BoundingVolume& volume) {
 // assimp's PLY reader (5.2) hangs on a header without end_header, and trusts the header's element counts:
 // "element vertex 99999999999" in an 80-byte file makes it loop and allocate for minutes. Every element instance takes at least one byte per property (one
 // byte for a property-less element), in ASCII and binary alike, so a header that declares more than the rest of
-// the file can hold is refused before assimp sees it. Files that do not start with the "ply" magic are not PLY.
+// the file can hold is refused before assimp sees it, as is a header without end_header.
 Status check_ply_header(const std::string& path) {
     std::ifstream stream(path, std::ios::binary);
-    char magic[4] = {};
-    if (!stream.read(magic, 4) || std::string_view(magic, 3) != "ply" || (magic[3] != '\n' && magic[3] != '\r'))
-        return Ok{};
+    // assimp takes any file starting with these three letters as PLY, whatever follows them on the line.
+    char magic[3] = {};
+    if (!stream.read(magic, 3) || std::string_view(magic, 3) != "ply") return Ok{};
     stream.seekg(0, std::ios::end);
     const auto file_size = static_cast<std::uint64_t>(stream.tellg());
     stream.seekg(0);

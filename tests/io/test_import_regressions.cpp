@@ -88,6 +88,21 @@ TEST(ImportRegressions, PlyHeaderWithoutEndIsRefused) {
     EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
 }
 
+// A binary PLY whose magic line is "ply" plus garbage and whose header never ends: assimp 5.2 read out of bounds
+// (SEGV, found by fuzz_ply). The header check now applies to every file starting with "ply", as assimp's does.
+TEST(ImportRegressions, PlyWithGarbageAfterTheMagicIsChecked) {
+    const ScratchFolder folder("ply_magic");
+    const std::string bytes(
+        "ply\xff\xff\xff\xff\nformat binary_little_endian 1.0\nelement vertex 3\npr\x00\x00\x00\x00\x00\x00\x00\x00\x00o"
+        "perty float x\nproperty float y\nproperty float !z\nelement face 2\nproperty list uchar "
+        "int vertformat binary_little_endian 1.0\x00\x00\x00\x00\x00\x80?\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x00\x80?"
+        "\x00\x00\x00\x00\x03\x00\x00\x00\x00\x01\x00\x00\x00\x02\x00\x00\x00",
+        232);
+    const Result<ImportResult> imported = import_mesh(folder.write("crash.ply", bytes));
+    ASSERT_FALSE(imported.has_value());
+    EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+}
+
 // Coincident, collinear or coplanar collision pieces fitted zero-size volumes (a radius-0 sphere, a box of height
 // 0), which `hbvh convert` wrote and every XML reader of hbvh then refused.
 TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
