@@ -449,6 +449,8 @@ private:
         } else {
             volume = enclose_ellipsoid(world, Vec3(size[0], size[1], size[2]));
         }
+        if (!detail::is_representable(volume))
+            return error_at(geom, type + " geom '" + name + "' is too large: its position or size overflows double");
         result_.primitives.push_back({std::move(volume), name});
         return Ok{};
     }

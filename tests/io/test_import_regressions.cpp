@@ -10,6 +10,7 @@
 
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/mjcf.hpp"
+#include "hbvh/io/urdf.hpp"
 #include "hbvh/io/xml.hpp"
 
 namespace hbvh {
@@ -126,6 +127,36 @@ TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
                                        [&](const std::string& w) { return w.find(name) != std::string::npos; });
         EXPECT_TRUE(named) << name;
     }
+}
+
+// Sizes and positions near the limit of double were accepted although the volume could not be written (a half
+// size of 1e308 is a full size of inf), so `hbvh convert` wrote files hbvh could not read. Found with the fuzz
+// targets' round-trip property.
+TEST(ImportRegressions, OverflowingGeometryIsRefused) {
+    const ScratchFolder folder("overflow");
+    for (const std::string geom : {"<geom type=\"box\" size=\"1e308 1 1\"/>",
+                                   "<geom type=\"capsule\" fromto=\"-1e308 0 0 1e308 0 0\" size=\"1\"/>",
+                                   "<body pos=\"1e308 0 0\"><geom pos=\"1e308 0 0\" size=\"1\"/></body>"}) {
+        const Result<ImportResult> imported =
+            import_mjcf(folder.write("model.xml", "<mujoco>\n<worldbody>\n" + geom + "\n</worldbody>\n</mujoco>\n"));
+        ASSERT_FALSE(imported.has_value()) << geom;
+        EXPECT_EQ(imported.error().line, 3) << geom;
+        EXPECT_NE(imported.error().message.find("overflows double"), std::string::npos) << imported.error().message;
+    }
+    // Still fine a little below the limit.
+    const Result<ImportResult> large =
+        import_mjcf(folder.write("large.xml", "<mujoco><worldbody><geom type=\"box\" size=\"1e307 1 1\"/></worldbody></mujoco>"));
+    ASSERT_TRUE(large.has_value()) << large.error().to_string();
+    expect_round_trip(*large);
+
+    const Result<ImportResult> robot = import_urdf(folder.write(
+        "robot.urdf", "<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\">\n"
+                      "<collision><origin xyz=\"1e308 0 0\"/><geometry><sphere radius=\"1\"/></geometry></collision>\n"
+                      "</link>\n<joint name=\"j\" type=\"fixed\"><parent link=\"a\"/><child link=\"b\"/>"
+                      "<origin xyz=\"1e308 0 0\"/></joint>\n</robot>\n"));
+    ASSERT_FALSE(robot.has_value());
+    EXPECT_EQ(robot.error().line, 4);
+    EXPECT_NE(robot.error().message.find("overflows double"), std::string::npos) << robot.error().message;
 }
 
 // <include file="/dev/zero"> read forever (and /dev/stdin waited for input): included files come from the model,
