@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdio>
+#include <limits>
 #include <string>
 
 #include "hbvh/build/optimal.hpp"
@@ -45,7 +47,31 @@ ScaleOptions scale_options_within(const BuildOptions& options) {
     if (options.progress) scale.progress = options.progress;
     return scale;
 }
+
+std::string range_message(const Vec3& extent, const char* problem) {
+    char text[200];
+    std::snprintf(text, sizeof text, "the primitives span %.3g x %.3g x %.3g: %s", extent.x(), extent.y(),
+                  extent.z(), problem);
+    return text;
+}
 }  // namespace
+
+// Builders compare volumes of groups; once a volume overflows to infinity every choice ties and the exact
+// searches lose their pruning (optimal ran for minutes on 1e150-sized input). A factor 8 above the box's
+// own volume leaves room for the enlargements some builders try. Underflow is the mirror image: every
+// volume rounds to zero and all trees cost the same. A box flat in some axis is fine (its volume is
+// truly zero), so only a box of three positive extents whose volume is not a normal double is refused.
+Status check_finite_extent(std::span<const Primitive> primitives) {
+    Aabb box = Aabb::empty();
+    for (const Primitive& primitive : primitives) box = box.merged(world_aabb(primitive.volume));
+    const Vec3 extent = box.max - box.min;
+    const double volume = 8.0 * extent.x() * extent.y() * extent.z();
+    if (!extent.allFinite() || !std::isfinite(volume))
+        return Error{range_message(extent, "volumes overflow double precision; scale the model down"), "", 0};
+    if ((extent.array() > 0.0).all() && volume < std::numeric_limits<double>::min())
+        return Error{range_message(extent, "volumes underflow double precision; scale the model up"), "", 0};
+    return Ok{};
+}
 
 Algorithm auto_choice(std::size_t primitive_count) {
     if (primitive_count <= auto_optimal_max_primitives) return Algorithm::optimal;
@@ -69,6 +95,7 @@ std::string_view to_string(Algorithm algorithm) {
 
 Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
+    if (Status finite = check_finite_extent(primitives); !finite) return finite.error();
     switch (algorithm) {
         case Algorithm::two_level: return build_two_level(primitives, options.policy);
         case Algorithm::bnb_tightest:

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "convex_hull.hpp"
+#include "fit_context.hpp"
 #include "frames.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
@@ -146,15 +147,19 @@ void make_containing(Capsule& capsule, std::span<const Sphere> spheres) {
 
 Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes) {
     HBVH_ASSERT(!spheres.empty());
-    const detail::HullSummary hull = detail::summarize_hull(spheres);
+    return detail::fit_capsule_in(detail::make_fit_context(spheres, hint_axes), spheres, fit_sphere(spheres));
+}
+
+Capsule detail::fit_capsule_in(const FitContext& context, std::span<const Sphere> spheres, const Sphere& sphere) {
+    const detail::HullSummary& hull = context.hull;
 
     // Stage 1: candidate directions. The principal axes of the centres and of the hull, every axis of the
     // OBB candidate frames (world, DiTO, hints): a capsule's axis usually follows the longest box side.
-    const detail::SphereProxy proxy = detail::make_proxy(spheres, hull);
+    const detail::SphereProxy& proxy = context.proxy;
     const Mat3 point_frame = detail::principal_frame(detail::point_covariance(spheres));
     std::vector<Mat3> frames{point_frame, detail::principal_frame(hull.covariance), Mat3::Identity()};
-    for (const Mat3& axes : detail::dito_frames(spheres)) frames.push_back(axes);
-    for (const Mat3& axes : detail::select_hints(proxy, hint_axes)) frames.push_back(axes);
+    for (const Mat3& axes : context.dito) frames.push_back(axes);
+    for (const Mat3& axes : context.hints) frames.push_back(axes);
     std::vector<Vec3> directions;
     directions.reserve(3 * frames.size());
     for (const Mat3& frame : frames)
@@ -201,7 +206,6 @@ Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_
 
     // The minimum enclosing sphere is a capsule of length zero; with it as a candidate a capsule is never
     // worse than the sphere fitter.
-    const Sphere sphere = fit_sphere(spheres);
     if (sphere.volume() < best.volume()) best = Capsule{sphere.center, sphere.center, sphere.radius};
     make_containing(best, spheres);
     return best;

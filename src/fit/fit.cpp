@@ -4,10 +4,30 @@
 #include "hbvh/fit/fit.hpp"
 
 #include <limits>
+#include <optional>
+#include <vector>
+
+#include "capsule_bound.hpp"
+#include "fit_context.hpp"
 
 #include "hbvh/assert.hpp"
 
 namespace hbvh {
+namespace {
+
+/// True when no capsule around the context's spheres can cost less than `best_cost`, so fitting one
+/// could not change fit_best's answer (it keeps the earlier kind on ties). The capsule fitter costs
+/// more than the other three together; on compact sets a box or sphere usually wins by far.
+bool capsule_cannot_win(const detail::FitContext& context, std::span<const Mat3> planes, const VolumePolicy& policy,
+                        double best_cost) {
+    // The bound is computed in rounded arithmetic from coordinates relative to the set; this margin is
+    // far above that rounding, so a skip never depends on it.
+    constexpr double rounding_margin = 1e-6;
+    const double scale = policy.weight_of(BvType::capsule) * (1.0 - rounding_margin);
+    return scale * detail::capsule_volume_lower_bound(context.proxy, planes, best_cost / scale) >= best_cost;
+}
+
+}  // namespace
 
 Aabb fit_aabb(std::span<const Sphere> spheres) {
     HBVH_ASSERT(!spheres.empty());
@@ -31,11 +51,37 @@ BoundingVolume fit(BvType type, std::span<const Sphere> spheres, std::span<const
 }
 
 BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& policy, std::span<const Mat3> hint_axes) {
+    HBVH_ASSERT(!spheres.empty());
+    // The OBB and capsule fitters need the same hull, proxy, DiTO frames and hints, and the capsule
+    // fitter needs the enclosing sphere: compute each once, and only when some allowed kind needs it.
+    // The results are bit for bit those of the separate fitters.
+    const bool wants_obb = policy.is_allowed(BvType::obb);
+    const bool wants_sphere = policy.is_allowed(BvType::sphere);
+    const bool wants_capsule = policy.is_allowed(BvType::capsule);
+    std::optional<detail::FitContext> context;
+    if (wants_obb || wants_capsule) context = detail::make_fit_context(spheres, hint_axes);
+    std::optional<Sphere> enclosing;
+    if (wants_sphere || wants_capsule) enclosing = fit_sphere(spheres);
+
     std::optional<BoundingVolume> best;
     double best_cost = std::numeric_limits<double>::infinity();
+    // The cross-sections for the capsule bound: the OBB's axes once it is fitted (a tight box's axes give
+    // the strongest bound, so they go first), then the world axes.
+    std::vector<Mat3> bound_planes{Mat3::Identity()};
     for (BvType type : all_bv_types) {
         if (!policy.is_allowed(type)) continue;
-        BoundingVolume candidate = fit(type, spheres, hint_axes);
+        if (type == BvType::capsule && best && capsule_cannot_win(*context, bound_planes, policy, best_cost)) continue;
+        BoundingVolume candidate = [&]() -> BoundingVolume {
+            switch (type) {
+                case BvType::aabb: return fit_aabb(spheres);
+                case BvType::obb: return detail::fit_obb_in(*context, spheres);
+                case BvType::sphere: return *enclosing;
+                case BvType::capsule: return detail::fit_capsule_in(*context, spheres, *enclosing);
+            }
+            HBVH_ASSERT(false);
+            return fit_aabb(spheres);
+        }();
+        if (const Obb* box = std::get_if<Obb>(&candidate)) bound_planes.insert(bound_planes.begin(), box->rotation);
         const double candidate_cost = policy.weighted_volume(candidate);
         // Strict '<' keeps the earlier (simpler) kind on ties: AABB before OBB before sphere before capsule.
         if (!best || candidate_cost < best_cost) {

@@ -9,6 +9,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "hull_2d.hpp"
+
 namespace hbvh::detail {
 namespace {
 
@@ -43,28 +45,6 @@ double squared_distance_to_line(const Vec3& p, const Vec3& a, const Vec3& u) {
 /// A tiny relative pad (about 4 ulps of `magnitude`) that keeps containment true even when a
 /// caller's re-evaluation rounds differently (e.g. with fused multiply-add contraction).
 double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
-
-/// Convex hull of 2-D points, counter-clockwise, without collinear points (Andrew's monotone chain).
-std::vector<Eigen::Vector2d> hull_2d(std::vector<Eigen::Vector2d> points) {
-    std::sort(points.begin(), points.end(),
-              [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-    if (points.size() < 3) return points;
-    auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-        return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
-    };
-    std::vector<Eigen::Vector2d> hull(2 * points.size());
-    std::size_t k = 0;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-        while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
-        hull[k++] = points[i];
-    }
-    for (std::size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {
-        while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
-        hull[k++] = points[i];
-    }
-    hull.resize(k - 1);
-    return hull;
-}
 
 }  // namespace
 

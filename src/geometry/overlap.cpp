@@ -16,6 +16,11 @@ namespace {
 // reason; an absolute slack keeps the test scale-free). On a genuine axis the slack is negligible.
 constexpr double edge_axis_slack = 1e-13;
 
+// boxes_may_overlap() must never separate boxes that overlaps() accepts, though it computes R and t in a
+// different order (b's axes moved into a's frame by one more product): 1e-12 of the size covers that
+// rounding (a few u times the size) with a wide margin and is still far below any real gap.
+constexpr double face_axis_slack = 1e-12;
+
 // Segment pairs with sin^2(angle) below this are "nearly parallel": the line-line solution loses
 // accuracy as u / sin(angle), so endpoint distances (exact for parallel segments) join the candidates.
 constexpr double parallel_sin2 = 1e-6;
@@ -151,6 +156,16 @@ double segment_segment_squared_distance(const Vec3& p0, const Vec3& p1, const Ve
                          point_segment_squared_distance(q0, p0, p1), point_segment_squared_distance(q1, p0, p1)});
     }
     return best;
+}
+
+bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t) {
+    const Mat3 abs_r = r.cwiseAbs();
+    const double slack = face_axis_slack * (t.cwiseAbs().sum() + ea.sum() + eb.sum());
+    for (int i = 0; i < 3; ++i)
+        if (std::abs(t[i]) > ea[i] + eb.dot(abs_r.row(i)) + slack) return false;
+    for (int j = 0; j < 3; ++j)
+        if (std::abs(t.dot(r.col(j))) > eb[j] + ea.dot(abs_r.col(j)) + slack) return false;
+    return true;
 }
 
 bool overlaps(const Aabb& a, const Aabb& b) {

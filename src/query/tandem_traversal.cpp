@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
+#include <optional>
 
 #include "hbvh/assert.hpp"
 #include "hbvh/geometry/overlap.hpp"
@@ -47,59 +49,103 @@ void enclosing_sphere(const BoundingVolume& bv, Vec3& center, double& radius) {
     radius *= 1.0 + sphere_padding;
 }
 
-/// The BV moved by `t`; the same arithmetic as transformed() so that leaf tests match a brute force
-/// written with it bit for bit (an Aabb becomes an Obb).
-inline BoundingVolume moved(const BoundingVolume& bv, const RigidTransform& t) {
-    switch (bv.index()) {
-        case 0: return Obb::from_aabb(*std::get_if<Aabb>(&bv)).transformed(t);
-        case 1: return std::get_if<Obb>(&bv)->transformed(t);
-        case 2: return std::get_if<Sphere>(&bv)->transformed(t);
-        default: return std::get_if<Capsule>(&bv)->transformed(t);
+// The traversal reads one node per test: keep it compact (docs/queries.md, "Query layout").
+static_assert(sizeof(QueryNode) == 152);
+
+constexpr bool is_box(BvType type) { return type == BvType::aabb || type == BvType::obb; }
+
+/// One of b's nodes, brought into a's frame lazily: the centre at once (9 multiply-adds, enough for the
+/// sphere pre-test), the box axes or the full BV only when a pre-test passes, and then only once however
+/// many of a's nodes it meets.
+class MovedNode {
+public:
+    MovedNode(const QueryTree& tree, std::uint32_t index, const RigidTransform& t)
+        : node_(&tree.nodes()[index]), tree_(&tree), index_(index), center_(t.apply(node_->center)) {}
+
+    [[nodiscard]] const QueryNode& node() const { return *node_; }
+    [[nodiscard]] const Vec3& center() const { return center_; }
+    /// The box axes in a's frame.
+    const Mat3& rotation(const RigidTransform& t) {
+        if (!has_rotation_) {
+            rotation_.noalias() = t.rotation * node_->rotation;
+            has_rotation_ = true;
+        }
+        return rotation_;
     }
-}
+    /// The exact BV in a's frame, moved with the arithmetic of transformed() so that leaf tests match a
+    /// brute force written with it bit for bit (an Aabb becomes an Obb).
+    const BoundingVolume& volume(const RigidTransform& t) {
+        if (!volume_) volume_.emplace(transformed(tree_->volume(index_), t));
+        return *volume_;
+    }
 
-/// One of b's nodes, brought into a's frame lazily: the sphere centre at once (9 multiply-adds), the full
-/// BV only when a sphere pre-test passes, and then only once however many of a's nodes it meets.
-struct MovedNode {
-    const QueryNode* node = nullptr;
-    Vec3 sphere_center;
-    BoundingVolume volume;
-    bool has_volume = false;
-
-    MovedNode(const QueryNode& n, const RigidTransform& t) : node(&n), sphere_center(t.apply(n.sphere_center)) {}
+private:
+    const QueryNode* node_;
+    const QueryTree* tree_;
+    std::uint32_t index_;
+    bool has_rotation_ = false;
+    Vec3 center_;
+    Mat3 rotation_;
+    std::optional<BoundingVolume> volume_;
 };
 
-/// Exact overlap of a's node and b's moved node, after the enclosing-sphere pre-test.
-inline bool node_overlap(const QueryNode& na, MovedNode& nb, const RigidTransform& t) {
-    const double r = na.sphere_radius + nb.node->sphere_radius;
-    if ((na.sphere_center - nb.sphere_center).squaredNorm() > r * r) return false;
-    if (!nb.has_volume) {
-        nb.volume = moved(nb.node->volume, t);
-        nb.has_volume = true;
-    }
-    return overlaps(na.volume, nb.volume);
+/// The enclosing-sphere pre-test: false when the spheres are apart, so the BVs are too. Both centres in
+/// one frame, whichever is cheaper (the padding covers the rounding of either choice).
+inline bool spheres_meet(const QueryNode& x, const Vec3& other_center, double other_radius) {
+    const double r = x.sphere_radius + other_radius;
+    return (x.center - other_center).squaredNorm() <= r * r;
 }
 
-/// Stack of node pairs with room for the worst case of both trees, on the machine stack when it fits.
+/// Overlap of a's node ia and b's moved node once the spheres met: two leaves get the exact primitive
+/// test; inner pairs of boxes the six-face-axis test, which never rejects what the exact one accepts;
+/// two spheres are settled by the pre-test; other inner pairs get the exact test.
+inline bool refined_overlap(const QueryTree& a, std::uint32_t ia, MovedNode& nb, const RigidTransform& t) {
+    const QueryNode& na = a.nodes()[ia];
+    const QueryNode& b = nb.node();
+    if (na.child_count != 0 || b.child_count != 0) {
+        if (is_box(na.type) && is_box(b.type)) {
+            const Vec3 d = nb.center() - na.center;
+            if (na.type == BvType::aabb)  // identity axes: b's axes and centre are already in a's box frame
+                return boxes_may_overlap(na.half_extents, b.half_extents, nb.rotation(t), d);
+            return boxes_may_overlap(na.half_extents, b.half_extents, na.rotation.transpose() * nb.rotation(t),
+                                     na.rotation.transpose() * d);
+        }
+        if (na.type == BvType::sphere && b.type == BvType::sphere) return true;
+    }
+    return overlaps(a.volume(ia), nb.volume(t));
+}
+
+/// Both tests in a's frame.
+inline bool node_overlap(const QueryTree& a, std::uint32_t ia, MovedNode& nb, const RigidTransform& t) {
+    return spheres_meet(a.nodes()[ia], nb.center(), nb.node().sphere_radius) && refined_overlap(a, ia, nb, t);
+}
+
+/// Stack of node pairs with room for the worst case of both trees: uninitialised storage on the machine
+/// stack when it fits (no per-query cost), the heap otherwise.
 class PairStack {
 public:
-    explicit PairStack(std::size_t capacity) {
-        if (capacity > local_.size()) heap_.resize(capacity);
-        data_ = heap_.empty() ? local_.data() : heap_.data();
-        capacity_ = heap_.empty() ? local_.size() : heap_.size();
+    struct Entry {
+        std::uint32_t a, b;
+    };
+    explicit PairStack(std::size_t capacity) : capacity_(std::max(capacity, local_capacity)) {
+        if (capacity > local_capacity) {
+            heap_ = std::make_unique_for_overwrite<Entry[]>(capacity);
+            data_ = heap_.get();
+        }
     }
     void push(std::uint32_t ia, std::uint32_t ib) {
         HBVH_ASSERT(size_ < capacity_);
         data_[size_++] = {ia, ib};
     }
     [[nodiscard]] bool empty() const { return size_ == 0; }
-    std::pair<std::uint32_t, std::uint32_t> pop() { return data_[--size_]; }
+    Entry pop() { return data_[--size_]; }
 
 private:
-    std::array<std::pair<std::uint32_t, std::uint32_t>, 256> local_;
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> heap_;
-    std::pair<std::uint32_t, std::uint32_t>* data_ = nullptr;
-    std::size_t capacity_ = 0;
+    static constexpr std::size_t local_capacity = 1024;
+    std::array<Entry, local_capacity> local_;
+    std::unique_ptr<Entry[]> heap_;
+    Entry* data_ = local_.data();
+    std::size_t capacity_;
     std::size_t size_ = 0;
 };
 
@@ -109,23 +155,45 @@ void reset(CollideResult& result) {
     result.bv_tests = result.primitive_tests = result.nodes_visited = 0;
 }
 
+/// Counts a test between two nodes as a primitive test (two leaves) or a BV test.
+inline void count_test(const QueryNode& x, const QueryNode& y, CollideResult& result) {
+    ++(x.child_count == 0 && y.child_count == 0 ? result.primitive_tests : result.bv_tests);
+}
+
 /// Counts a test as a primitive test (two leaves) or a BV test, and runs it.
-inline bool counted_overlap(const QueryNode& na, MovedNode& nb, const RigidTransform& t, CollideResult& result) {
-    ++(na.child_count == 0 && nb.node->child_count == 0 ? result.primitive_tests : result.bv_tests);
-    return node_overlap(na, nb, t);
+inline bool counted_overlap(const QueryTree& a, std::uint32_t ia, MovedNode& nb, const RigidTransform& t,
+                            CollideResult& result) {
+    ++(a.nodes()[ia].child_count == 0 && nb.node().child_count == 0 ? result.primitive_tests : result.bv_tests);
+    return node_overlap(a, ia, nb, t);
 }
 
 }  // namespace
 
 QueryTree::QueryTree(const Bvh& bvh) {
     nodes_.reserve(bvh.nodes.size());
+    volumes_.reserve(bvh.nodes.size());
     primitive_nodes_.assign(bvh.primitives.size(), 0);
     std::vector<std::uint32_t> path_sum(bvh.nodes.size(), 0);
     for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
         const Node& node = bvh.nodes[i];
-        QueryNode q{node.volume, Vec3::Zero(), 0.0, volume(node.volume), node.first_child, node.child_count, node.primitive};
-        enclosing_sphere(node.volume, q.sphere_center, q.sphere_radius);
-        nodes_.push_back(std::move(q));
+        QueryNode q;
+        q.center = Vec3::Zero();
+        q.rotation = Mat3::Identity();
+        q.half_extents = Vec3::Zero();
+        q.measure = hbvh::volume(node.volume);
+        q.first_child = node.first_child;
+        q.child_count = node.child_count;
+        q.primitive = node.primitive;
+        q.type = type_of(node.volume);
+        enclosing_sphere(node.volume, q.center, q.sphere_radius);
+        if (const auto* box = std::get_if<Aabb>(&node.volume)) {
+            q.half_extents = box->half_extents();
+        } else if (const auto* obb = std::get_if<Obb>(&node.volume)) {
+            q.rotation = obb->rotation;
+            q.half_extents = obb->half_extents;
+        }
+        nodes_.push_back(q);
+        volumes_.push_back(node.volume);
         if (node.is_leaf()) {
             HBVH_ASSERT(node.primitive < primitive_nodes_.size());
             primitive_nodes_[node.primitive] = i;
@@ -148,12 +216,13 @@ void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& 
     reset(result);
     if (a.empty() || b.empty()) return;
     const RigidTransform t = relative_transform(pose_a, pose_b);
+    const RigidTransform t_inverse = t.inverse();
     const std::span<const QueryNode> na = a.nodes(), nb = b.nodes();
 
     // Stage 1: the roots.
     {
-        MovedNode root_b(nb[0], t);
-        if (!counted_overlap(na[0], root_b, t, result)) return;
+        MovedNode root_b(b, 0, t);
+        if (!counted_overlap(a, 0, root_b, t, result)) return;
     }
     if (na[0].child_count == 0 && nb[0].child_count == 0) {
         result.intersecting = true;
@@ -179,9 +248,11 @@ void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& 
         // Erleben et al.: descend the larger volume, so both trees shrink at about the same pace.
         const bool descend_a = node_b.child_count == 0 || (node_a.child_count != 0 && node_a.measure >= node_b.measure);
         if (descend_a) {
-            MovedNode moved_b(node_b, t);  // moved once for all of a's children
+            MovedNode moved_b(b, ib, t);  // moved once for all of a's children
             for (std::uint32_t c = node_a.first_child; c < node_a.first_child + node_a.child_count; ++c) {
-                if (!counted_overlap(na[c], moved_b, t, result)) continue;
+                count_test(na[c], node_b, result);
+                if (!spheres_meet(na[c], moved_b.center(), node_b.sphere_radius)) continue;
+                if (!refined_overlap(a, c, moved_b, t)) continue;
                 if (na[c].child_count == 0 && node_b.child_count == 0) {
                     report(c, ib);
                     if (mode == CollideMode::first) return;
@@ -190,9 +261,29 @@ void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& 
                 }
             }
         } else {
+            // a's node stays put; its sphere centre goes into b's frame once, so that the pre-test of b's
+            // children needs no transform, and only children that pass it are moved into a's frame.
+            const Vec3 center_a = t_inverse.apply(node_a.center);
+            // For box-box inner tests, b's model frame -> a's box frame in one go, so that each child of
+            // b costs one 3x3 product instead of two.
+            Mat3 to_box_a;
+            Vec3 offset_a;
+            if (is_box(node_a.type)) {
+                to_box_a.noalias() = node_a.rotation.transpose() * t.rotation;
+                offset_a.noalias() = node_a.rotation.transpose() * (t.translation - node_a.center);
+            }
             for (std::uint32_t c = node_b.first_child; c < node_b.first_child + node_b.child_count; ++c) {
-                MovedNode moved_c(nb[c], t);
-                if (!counted_overlap(node_a, moved_c, t, result)) continue;
+                const QueryNode& child = nb[c];
+                count_test(node_a, child, result);
+                if (!spheres_meet(child, center_a, node_a.sphere_radius)) continue;
+                if (is_box(node_a.type) && is_box(child.type) && (node_a.child_count != 0 || child.child_count != 0)) {
+                    const Mat3 axes = to_box_a * child.rotation;
+                    const Vec3 center = to_box_a * child.center + offset_a;
+                    if (!boxes_may_overlap(node_a.half_extents, child.half_extents, axes, center)) continue;
+                } else {
+                    MovedNode moved_c(b, c, t);
+                    if (!refined_overlap(a, ia, moved_c, t)) continue;
+                }
                 if (node_a.child_count == 0 && nb[c].child_count == 0) {
                     report(ia, c);
                     if (mode == CollideMode::first) return;
@@ -224,8 +315,8 @@ void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const Q
     const RigidTransform t = relative_transform(pose_a, pose_b);
     const std::span<const QueryNode> na = a.nodes(), nb = b.nodes();
     {
-        MovedNode root_b(nb[0], t);
-        if (!counted_overlap(na[0], root_b, t, result)) return;
+        MovedNode root_b(b, 0, t);
+        if (!counted_overlap(a, 0, root_b, t, result)) return;
     }
     result.nodes_visited = 1;
     if (na[0].child_count == 0 && nb[0].child_count == 0) {  // two lone primitives: already tested
@@ -236,10 +327,10 @@ void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const Q
     // Every primitive pair, each of b's primitives moved once. Primitive tests use the same pre-test
     // as tandem traversal so that the comparison measures the hierarchy, not the pair test.
     for (const std::uint32_t leaf_b : b.primitive_nodes()) {
-        MovedNode moved_b(nb[leaf_b], t);
+        MovedNode moved_b(b, leaf_b, t);
         for (const std::uint32_t leaf_a : a.primitive_nodes()) {
             ++result.primitive_tests;
-            if (!node_overlap(na[leaf_a], moved_b, t)) continue;
+            if (!node_overlap(a, leaf_a, moved_b, t)) continue;
             result.intersecting = true;
             result.pairs.emplace_back(na[leaf_a].primitive, nb[leaf_b].primitive);
             if (mode == CollideMode::first) return;

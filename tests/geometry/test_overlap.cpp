@@ -426,5 +426,49 @@ TEST(OverlapCases, TouchingSeparatedNested) {
     EXPECT_TRUE(overlaps(Capsule{Vec3(-1, 0, 0), Vec3(1, 0, 0), 1.0}, Capsule{Vec3(0, 0, 0), Vec3(0.1, 0, 0), 0.1}));
 }
 
+/// boxes_may_overlap (the traversal's inner box test) in the frame of box a, as the traversal forms it:
+/// b's axes moved by a rigid motion first, then taken into a's frame.
+bool may_overlap(const Obb& a, const Obb& b_model, const RigidTransform& t) {
+    const Mat3 moved_axes = t.rotation * b_model.rotation;
+    const Mat3 at = a.rotation.transpose();
+    return boxes_may_overlap(a.half_extents, b_model.half_extents, at * moved_axes, at * (t.apply(b_model.center) - a.center));
+}
+
+TEST(BoxesMayOverlap, NeverRejectsAnExactOverlapIncludingTouching) {
+    SplitMix64 rng(4242);
+    int overlapping = 0, rejected_separated = 0;
+    for (int n = 0; n < 20000; ++n) {
+        const double zoom = log_uniform(rng, 1e-3, 1e3);
+        const Obb a = std::get<Obb>(zoomed(random_volume(rng, BvType::obb, Vec3::Zero(), 1.0), zoom));
+        const Obb b_model = std::get<Obb>(random_volume(rng, BvType::obb, Vec3::Zero(), zoom));
+        const Vec3 direction = rng.rotation().col(0);
+        const RigidTransform spin{rng.rotation(), Vec3::Zero()};
+        // Slide b along `direction` to the distance where the exact test flips (bisection), then test
+        // just inside that distance (touching up to rounding) and at random distances.
+        const auto at = [&](double d) { return RigidTransform{spin.rotation, d * direction}; };
+        const auto exact = [&](double d) { return overlaps(a, b_model.transformed(at(d))); };
+        double lo = 0.0, hi = 4.0 * zoom;
+        if (!exact(lo) || exact(hi)) continue;
+        for (int k = 0; k < 80; ++k) (exact(0.5 * (lo + hi)) ? lo : hi) = 0.5 * (lo + hi);
+        for (const double d : {lo, lo * (1 - 1e-12), rng.uniform(0.0, hi), hi * (1 + 1e-3), rng.uniform(hi, 4 * zoom)}) {
+            const bool real = exact(d);
+            const bool maybe = may_overlap(a, b_model, at(d));
+            if (real) {
+                ++overlapping;
+                EXPECT_TRUE(maybe) << "config " << n << " distance " << d;
+            } else if (!maybe) {
+                ++rejected_separated;
+            }
+        }
+    }
+    EXPECT_GT(overlapping, 20000);
+    // Face axes separate most separated pairs: the test must still prune.
+    EXPECT_GT(rejected_separated, 10000);
+    // Separated along a face axis of either box: rejected; separated only along an edge-edge axis: not.
+    const Obb unit{Vec3::Zero(), Mat3::Identity(), Vec3::Ones()};
+    EXPECT_FALSE(may_overlap(unit, unit, RigidTransform{Mat3::Identity(), Vec3(2.0 + 1e-9, 0, 0)}));
+    EXPECT_TRUE(may_overlap(unit, unit, RigidTransform{Mat3::Identity(), Vec3(2.0, 0, 0)}));
+}
+
 }  // namespace
 }  // namespace hbvh

@@ -233,5 +233,51 @@ TEST(TandemTraversal, StackBoundCoversTwoLevelFanOut) {
     EXPECT_EQ(r.pairs, brute_force(bvh, pose, bvh, pose));
 }
 
+TEST(TandemTraversal, HeapStackBeyondTheLocalCapacity) {
+    // Two two-level trees over 600 primitives: 1201 stack entries, beyond the 1024 kept on the machine stack.
+    const auto prims = generate_scene({.count = 600, .seed = 6});
+    const Bvh bvh = build(prims, Algorithm::two_level).value();
+    const QueryTree tree(bvh);
+    ASSERT_GT(2 * tree.stack_bound() + 1, 1024u);
+    const RigidTransform pose_b = pose_near(bvh, RigidTransform::identity(), bvh, 11, 0.3);
+    const CollideResult r = collide(tree, RigidTransform::identity(), tree, pose_b, CollideMode::all);
+    EXPECT_EQ(r.pairs, brute_force(bvh, RigidTransform::identity(), bvh, pose_b));
+}
+
+TEST(QueryTree, EnclosingSpheresContainEveryNode) {
+    // The sphere pre-test may only reject pairs whose BVs are apart: each node's sphere (centre, padded
+    // radius) must contain its BV, checked on the BV's generating spheres, for every kind of BV.
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+        const auto prims = generate_scene({.count = 27, .seed = seed});
+        const Bvh bvh = build_deep_mixed(prims, seed);
+        const QueryTree tree(bvh);
+        ASSERT_EQ(tree.nodes().size(), bvh.nodes.size());
+        for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+            const QueryNode& node = tree.nodes()[i];
+            EXPECT_EQ(node.type, type_of(bvh.nodes[i].volume));
+            for (const Sphere& s : generating_spheres(bvh.nodes[i].volume))
+                EXPECT_LE((s.center - node.center).norm() + s.radius, node.sphere_radius) << "node " << i;
+        }
+    }
+}
+
+TEST(QueryTree, PreTestsNeverRejectAnExactOverlap) {
+    // Random pairs of single-node trees of every kind, moved so that they touch or overlap: whatever the
+    // kinds, collide() on inner-node-free trees is the exact test, and on trees whose roots are inner
+    // nodes the conservative tests must still reach every overlapping primitive pair (brute force).
+    SplitMix64 rng(31);
+    for (int n = 0; n < 200; ++n) {
+        const auto prims = generate_scene({.count = 2 + static_cast<std::uint32_t>(rng.below(6)), .seed = 500u + n});
+        const Bvh bvh = build_deep_mixed(prims, 900u + n);
+        const QueryTree tree(bvh);
+        for (int k = 0; k < 10; ++k) {
+            const RigidTransform pose_b = pose_near(bvh, RigidTransform::identity(), bvh, 10000u * n + k, 0.5);
+            EXPECT_EQ(collide(tree, RigidTransform::identity(), tree, pose_b).pairs,
+                      brute_force(bvh, RigidTransform::identity(), bvh, pose_b))
+                << "tree " << n << " pose " << k;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace hbvh

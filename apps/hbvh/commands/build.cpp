@@ -5,7 +5,9 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <string>
 
 #include "commands/command.hpp"
 #include "hbvh/io/xml.hpp"
@@ -22,7 +24,21 @@ struct BuildArguments {
     bool stats = false;
 };
 
-void print_report(const BuildReport& report, double seconds) {
+/// What is proven about the tree's cost: "lower bound L, gap G %" when the builder knows a global bound
+/// (BuildReport::lower_bound > 0; only `optimal` does, with L = the optimum), else "no global bound known".
+std::string bound_summary(const BuildReport& report, double cost) {
+    std::string text = "no global bound known";
+    if (report.lower_bound > 0.0) {
+        // The bound and the tree's recomputed cost may differ in the last bits: print that as 0.00 %.
+        const double gap = cost / report.lower_bound - 1.0;
+        text = fmt::format("proven lower bound {:.6g}, gap {:.2f} %", report.lower_bound,
+                           std::abs(gap) < 5e-5 ? 0.0 : 100.0 * gap);
+    }
+    if (report.budget_hit) text += "; budget hit (best tree found within the node/time budget)";
+    return text;
+}
+
+void print_report(const BuildReport& report, double seconds, double cost) {
     fmt::print(stderr, "{:>5} {:>7} {:>10} {:>13} {:>7} {:>11}  notes\n", "level", "nodes", "candidates", "solver-nodes",
                "groups", "time-ms");
     for (std::size_t i = 0; i < report.levels.size(); ++i) {
@@ -32,6 +48,7 @@ void print_report(const BuildReport& report, double seconds) {
                    level.budget_hit ? "budget-hit" : "");
     }
     for (const std::string& note : report.notes) fmt::print(stderr, "note: {}\n", note);
+    fmt::print(stderr, "cost: {:.6g}; {}\n", cost, bound_summary(report, cost));
     fmt::print(stderr, "total: {:.3f} ms\n", 1e3 * seconds);
 }
 
@@ -68,11 +85,13 @@ int run_build(const BuildArguments& args) {
     if (bar_drawn) fmt::print(stderr, "\n");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!bvh) return report_error(bvh.error());
-    if (args.report) print_report(report, seconds);
-    if (args.stats) {
+    if (args.report || args.stats) {
         const Stats stats = compute_stats(bvh.value(), options.policy);
-        fmt::print(stderr, "{}: {} primitives, {} nodes, height {}, cost {:.6g} ({} in {:.3f} ms)\n", args.input,
-                   stats.leaves, stats.nodes, stats.height, stats.cost, to_string(algorithm), 1e3 * seconds);
+        if (args.report) print_report(report, seconds, stats.cost);
+        if (args.stats)
+            fmt::print(stderr, "{}: {} primitives, {} nodes, height {}, cost {:.6g} ({} in {:.3f} ms); {}\n", args.input,
+                       stats.leaves, stats.nodes, stats.height, stats.cost, to_string(algorithm), 1e3 * seconds,
+                       bound_summary(report, stats.cost));
     }
     if (Status written = write_output(args.output, write_xml(bvh.value())); !written) return report_error(written.error());
     return exit_ok;
@@ -86,8 +105,10 @@ void add_build_command(CLI::App& app, Command& command) {
     sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML), or - for stdout")->capture_default_str();
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     args->builder.add_to(*sub);
-    sub->add_flag("--report", args->report, "Print the per-level build report to stderr");
-    sub->add_flag("--stats", args->stats, "Print a one-line summary (cost, height, time) to stderr");
+    sub->add_flag("--report", args->report,
+                  "Print the per-level build report to stderr, with the proven lower bound and gap when known");
+    sub->add_flag("--stats", args->stats,
+                  "Print a one-line summary (cost, height, time, lower bound and gap when known) to stderr");
     sub->footer("Example: hbvh build data/models/chair.xml -a two-level -o chair.hbvh.xml --stats");
     sub->callback([&command, args] { command = [args] { return run_build(*args); }; });
 }

@@ -10,11 +10,23 @@
 #include "commands/command.hpp"
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/import.hpp"
+#include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/xml.hpp"
 
 namespace hbvh::cli {
 
-Result<Model> load_model(const std::string& path, const std::string& format) {
+namespace {
+/// The file as a Model, without checks across primitives (load_model adds those).
+Result<Model> read_model(const std::string& path, const std::string& format) {
+    // A plain mesh (no UBX_/USP_/UCP_/UCX_ pieces) is imported only on request: one fitted primitive per
+    // mesh node is a guess at the author's intent, not a reading of it.
+    if (format == "mesh-nodes") {
+        MeshImportOptions options;
+        options.one_primitive_per_mesh = true;
+        Result<ImportResult> imported = import_mesh(path, options);
+        if (!imported) return imported.error();
+        return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
+    }
     // The survey format keeps a stored hierarchy; the importers give primitives only.
     static const std::pair<const char*, ImportFormat> formats[] = {
         {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
@@ -22,7 +34,7 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
     const auto chosen = std::find_if(std::begin(formats), std::end(formats),
                                      [&](const auto& entry) { return format == entry.first; });
     if (chosen == std::end(formats))
-        return Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf or mesh)", path};
+        return Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)", path};
 
     const std::string extension = std::filesystem::path(path).extension().string();
     const bool maybe_survey = path == "-" || chosen->second == ImportFormat::survey_xml ||
@@ -47,6 +59,16 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
     if (!imported) return imported.error();
     if (imported->primitives.empty()) return Error{"the file holds no collision primitives", path};
     return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
+}
+}  // namespace
+
+Result<Model> load_model(const std::string& path, const std::string& format) {
+    Result<Model> model = read_model(path, format);
+    if (!model) return model;
+    // Refused here rather than in build() so that the message names the file.
+    if (Status finite = check_finite_extent(model->primitives); !finite)
+        return Error{finite.error().message, path == "-" ? "<stdin>" : path};
+    return model;
 }
 
 Status write_output(const std::string& path, const std::string& content) {

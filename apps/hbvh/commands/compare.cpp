@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
-// `hbvh compare`: every builder on every model, as the survey's Tables 2 and 3.
+// `hbvh compare`: every builder on every model, as the survey's Tables 2 and 3, with each row's gap to
+// the proven optimum (the `optimal` builder's subset DP) on models small enough for it.
 #include <fmt/core.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <filesystem>
 #include <nlohmann/json.hpp>
+#include <optional>
 
 #include "commands/command.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -17,6 +20,12 @@ struct CompareArguments {
     std::string algorithm_list;  // empty = all registered
     BuilderFlags builder;
     int repeats = 5;
+    /// Models with at most this many primitives get the optimum (and a gap column); clamped to the
+    /// optimal builder's own limit, since compare never lets it fall back to a heuristic tree.
+    std::uint32_t optimum_max_primitives = OptimalOptions{}.max_primitives;
+    /// Search-node budget per call of the survey's reference branch and bound (bnb-tightest, bnb-enlarge,
+    /// and the bnb-enlarge tree inside bnb-exact); 0 keeps the library default.
+    std::uint64_t bnb_nodes = 0;
     bool json = false;
     bool markdown = false;
 };
@@ -30,9 +39,18 @@ struct Row {
     double cost = 0.0;
     std::uint32_t height = 0;
     double relative = 0.0;  ///< cost / two-level cost
+    std::optional<double> gap;  ///< cost / optimum - 1, when the model's optimum is known
+    std::optional<double> optimum;  ///< Set on `optimal` rows: the proven optimum's Eq. 2 cost
     bool budget_hit = false;
     std::string error;
 };
+
+/// "12.34 %" (or "-" when unknown) for the text and Markdown tables. A tree as cheap as the optimum may
+/// differ from it in the last bits; that prints as 0.00 %, not -0.00 %.
+std::string format_gap(const std::optional<double>& gap) {
+    if (!gap) return "-";
+    return fmt::format("{:.2f} %", std::abs(*gap) < 5e-5 ? 0.0 : 100.0 * *gap);
+}
 
 std::vector<std::string> split_names(const std::string& list) {
     std::vector<std::string> names;
@@ -66,6 +84,7 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, Build
         row.height = stats.height;
         row.candidates = report.total_candidates;
         row.budget_hit = report.budget_hit;
+        if (algorithm == Algorithm::optimal) row.optimum = stats.cost;
         // A build that takes seconds is measured once: its median would not change the table.
         if (times.back() > 1000.0) break;
     }
@@ -74,31 +93,42 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, Build
     return row;
 }
 
+/// `options` with --time-limit also given to the survey's reference branch and bound (bnb-tightest,
+/// bnb-enlarge), which the library leaves to its node budget: spread over its ~2 log2 n solver calls,
+/// as build() does for bnb-exact. scale and bnb-exact get the limit from build() itself.
+BuildOptions within_time_limit(BuildOptions options, std::size_t primitive_count) {
+    if (options.time_limit_seconds > 0.0) {
+        const double calls = 2.0 * std::max(1.0, std::log2(static_cast<double>(primitive_count)));
+        options.branch_and_bound.budget.max_seconds = options.time_limit_seconds / calls;
+    }
+    return options;
+}
+
 void print_markdown(const std::vector<Row>& rows) {
-    fmt::print("| model | algorithm | primitives | time (ms) | MC | cost | height | cost / two-level |\n");
-    fmt::print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    fmt::print("| model | algorithm | primitives | time (ms) | MC | cost | height | cost / two-level | gap to optimum |\n");
+    fmt::print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for (const Row& row : rows) {
         if (!row.error.empty()) {
-            fmt::print("| {} | {} | {} | error: {} | | | | |\n", row.model, row.algorithm, row.primitives, row.error);
+            fmt::print("| {} | {} | {} | error: {} | | | | | |\n", row.model, row.algorithm, row.primitives, row.error);
             continue;
         }
-        fmt::print("| {} | {} | {} | {:.3f} | {} | {:.6g} | {} | {:.3f}{} |\n", row.model, row.algorithm, row.primitives,
-                   row.median_ms, row.candidates, row.cost, row.height, row.relative,
-                   row.budget_hit ? " (budget hit)" : "");
+        fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", row.model, row.algorithm,
+                   row.primitives, row.median_ms, row.budget_hit ? " (budget hit)" : "", row.candidates, row.cost,
+                   row.height, row.relative, format_gap(row.gap));
     }
 }
 
 void print_text(const std::vector<Row>& rows) {
-    fmt::print("{:<20} {:<16} {:>6} {:>11} {:>6} {:>14} {:>6} {:>9}\n", "model", "algorithm", "prims", "time-ms", "MC",
-               "cost", "height", "vs-2lvl");
+    fmt::print("{:<20} {:<16} {:>6} {:>11} {:>6} {:>14} {:>6} {:>9} {:>10}\n", "model", "algorithm", "prims", "time-ms",
+               "MC", "cost", "height", "vs-2lvl", "gap-opt");
     for (const Row& row : rows) {
         if (!row.error.empty()) {
             fmt::print("{:<20} {:<16} error: {}\n", row.model, row.algorithm, row.error);
             continue;
         }
-        fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9.3f}{}\n", row.model, row.algorithm,
+        fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9.3f} {:>10}{}\n", row.model, row.algorithm,
                    row.primitives, row.median_ms, row.candidates, row.cost, row.height, row.relative,
-                   row.budget_hit ? "  budget-hit" : "");
+                   format_gap(row.gap), row.budget_hit ? "  budget-hit" : "");
     }
 }
 
@@ -109,6 +139,8 @@ void print_json(const std::vector<Row>& rows) {
                              {"time_ms", row.median_ms},   {"candidates", row.candidates}, {"cost", row.cost},
                              {"height", row.height},       {"relative_to_two_level", row.relative},
                              {"budget_hit", row.budget_hit}};
+        // A fraction (0.05 = 5 % above the optimum); null where the optimum is unknown.
+        entry["gap_to_optimum"] = row.gap ? nlohmann::json(*row.gap) : nlohmann::json(nullptr);
         if (!row.error.empty()) entry["error"] = row.error;
         out.push_back(entry);
     }
@@ -134,19 +166,49 @@ int run_compare(const CompareArguments& args) {
         fmt::print(stderr, "hbvh compare: {}\n", resolved.error().to_string());
         return exit_bad_usage;
     }
-    const BuildOptions& options = resolved->second;
+    BuildOptions options = resolved->second;
+    // An `optimal` row is the optimum or an error, never bnb-exact's tree under optimal's name.
+    options.optimal.fall_back = false;
+    if (args.bnb_nodes > 0) {
+        options.branch_and_bound.budget.max_nodes = args.bnb_nodes;
+        options.bnb_exact.enlarge_options.budget.max_nodes = args.bnb_nodes;
+    }
+    const std::uint32_t optimum_limit =
+        std::min({args.optimum_max_primitives, options.optimal.max_primitives, optimal_hard_limit});
     std::vector<Row> rows;
     for (const std::string& input : args.inputs) {
         Result<Model> model = load_model(input);
         if (!model) return report_error(model.error());
         report_warnings(model->warnings);
-        const double baseline = measure(model->primitives, Algorithm::two_level, options, 1).cost;
+        const std::size_t count = model->primitives.size();
+        const std::string name = std::filesystem::path(input).stem().string();
+        fmt::print(stderr, "hbvh compare: {} ({} primitives)\n", name, count);
+        const BuildOptions model_options = within_time_limit(options, count);
+        const double baseline = measure(model->primitives, Algorithm::two_level, model_options, 1).cost;
+        const std::size_t first = rows.size();
         for (Algorithm algorithm : chosen) {
-            Row row = measure(model->primitives, algorithm, options, args.repeats);
-            row.model = std::filesystem::path(input).stem().string();
+            Row row;
+            if (algorithm == Algorithm::optimal && count > optimum_limit) {
+                // Not built: its subset DP doubles per primitive (docs/solver.md §2).
+                row.algorithm = std::string(to_string(algorithm));
+                row.primitives = count;
+                row.error = fmt::format("skipped: {} primitives > {} (optimum limit)", count, optimum_limit);
+            } else {
+                row = measure(model->primitives, algorithm, model_options, args.repeats);
+            }
+            row.model = name;
             row.relative = baseline > 0.0 ? row.cost / baseline : 1.0;
             rows.push_back(std::move(row));
         }
+        // The optimum: the `optimal` row's when the list has one, else one extra build.
+        std::optional<double> optimum;
+        if (count <= optimum_limit) {
+            for (std::size_t i = first; i < rows.size() && !optimum; ++i) optimum = rows[i].optimum;
+            if (!optimum) optimum = measure(model->primitives, Algorithm::optimal, model_options, 1).optimum;
+        }
+        if (optimum && *optimum > 0.0)
+            for (std::size_t i = first; i < rows.size(); ++i)
+                if (rows[i].error.empty()) rows[i].gap = rows[i].cost / *optimum - 1.0;
     }
     if (args.json)
         print_json(rows);
@@ -166,10 +228,21 @@ void add_compare_command(CLI::App& app, Command& command) {
     sub->add_option("--repeat", args->repeats, "Builds per row; the median time is reported")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
+    sub->add_option("--optimum-max-primitives", args->optimum_max_primitives,
+                    "Compute the optimum (gap column) for models up to this size; at most the optimal builder's limit")
+        ->capture_default_str();
+    sub->add_option("--bnb-nodes", args->bnb_nodes,
+                    "Search-node budget per solver call of the survey's branch and bound (0 = library default)");
     args->builder.add_to(*sub);
     sub->add_flag("--json", args->json, "Print JSON");
     sub->add_flag("--markdown", args->markdown, "Print a Markdown table");
-    sub->footer("Example: hbvh compare data/models/*.xml --markdown");
+    sub->footer(
+        "Gap to optimum: cost / optimum - 1 (JSON: gap_to_optimum, a fraction, null when unknown), where the\n"
+        "optimum is the optimal builder's proven Eq. 2 minimum; computed for models of at most\n"
+        "--optimum-max-primitives primitives. Rows whose solver stopped at its budget are marked.\n"
+        "--time-limit also bounds bnb-tightest and bnb-enlarge here (spread over their solver calls); it bounds\n"
+        "solver searches, not candidate fitting, so a row can take longer. optimal and the heuristics ignore it.\n"
+        "Example: hbvh compare data/models/*.xml --markdown");
     sub->callback([&command, args] { command = [args] { return run_compare(*args); }; });
 }
 

@@ -83,6 +83,10 @@ inline constexpr std::uint32_t auto_exact_max_primitives = 24;
 /// The builder `auto` uses for `primitive_count` primitives.
 [[nodiscard]] Algorithm auto_choice(std::size_t primitive_count);
 
+/// Ok when the primitives' world box has a finite volume; otherwise an Error (no file) saying the model
+/// must be scaled down. build() checks this first: Eq. 2 is meaningless once volumes overflow to infinity.
+[[nodiscard]] Status check_finite_extent(std::span<const Primitive> primitives);
+
 /// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
 /// Returns an Error for an empty input.
 [[nodiscard]] Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm,

@@ -44,6 +44,13 @@ namespace hbvh {
 /// Any pair of bounding volumes (both in the same frame), dispatched once with std::visit.
 [[nodiscard]] bool overlaps(const BoundingVolume& a, const BoundingVolume& b);
 
+/// Conservative box-box test for traversals: the separating-axis test on the six face normals only
+/// (the nine edge-edge axes are skipped), with a slack of 1e-12 of the configuration's size so that
+/// rounding never separates touching boxes. Never false when overlaps() of the two boxes is true; may be
+/// true for separated boxes (only an edge-edge axis separates them). Box a is [-ea, ea] in its own
+/// frame; box b has half extents eb, axes R's columns (R(i, j) = A_i . B_j) and centre t in a's frame.
+[[nodiscard]] bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t);
+
 /// Squared distance between the segments p0-p1 and q0-q1 (any frame). Zero-length segments are points;
 /// parallel segments are handled exactly (the minimum over endpoint distances joins the line solution).
 [[nodiscard]] double segment_segment_squared_distance(const Vec3& p0, const Vec3& p1, const Vec3& q0,

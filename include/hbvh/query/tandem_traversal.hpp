@@ -28,20 +28,24 @@ struct CollideResult {
     std::uint64_t nodes_visited = 0;    ///< Node pairs found overlapping and then expanded or reported.
 };
 
-/// One node of a QueryTree. Same indices as the Bvh it came from; everything in the Bvh's model frame.
+/// One node of a QueryTree: the hot data of the traversal, 152 bytes. Same indices as the Bvh it came
+/// from; everything in the Bvh's model frame. The exact BV lives in QueryTree::volume(i) (cold).
 struct QueryNode {
-    BoundingVolume volume;           ///< The node's BV (for a leaf: its primitive's exact geometry).
-    Vec3 sphere_center;              ///< Centre of a sphere enclosing `volume` (the cheap pre-test).
-    double sphere_radius = 0.0;      ///< Its radius, padded by 1e-12 relative so containment survives rounding.
-    double measure = 0.0;            ///< volume(volume): the descent rule compares these.
-    std::uint32_t first_child = 0;   ///< Children: [first_child, first_child + child_count).
-    std::uint32_t child_count = 0;   ///< 0 for a leaf.
-    std::uint32_t primitive = 0;     ///< For a leaf: the primitive's index in input order.
+    Vec3 center;                    ///< Box / sphere centre, capsule midpoint; also the enclosing sphere's centre.
+    double sphere_radius = 0.0;     ///< Radius of a sphere around the BV, padded by 1e-12 relative.
+    Mat3 rotation;                  ///< Box axes as columns (identity for an Aabb); identity otherwise.
+    Vec3 half_extents;              ///< Box half extents; zero otherwise.
+    double measure = 0.0;           ///< volume(volume): the descent rule compares these.
+    std::uint32_t first_child = 0;  ///< Children: [first_child, first_child + child_count).
+    std::uint32_t child_count = 0;  ///< 0 for a leaf.
+    std::uint32_t primitive = 0;    ///< For a leaf: the primitive's index in input order.
+    BvType type = BvType::aabb;     ///< The kind of the node's BV.
 };
 
 /// The read-only layout queries run on, converted once from a Bvh (which stays the ground truth):
-/// flat node array, children contiguous, BVs in the model frame with their enclosing spheres and
-/// volumes precomputed, and the stack depth a traversal can need.
+/// flat node array, children contiguous, boxes as centre + axes + half extents with their enclosing
+/// spheres and volumes precomputed, the exact BVs in a separate array, and the stack depth a traversal
+/// can need.
 class QueryTree {
 public:
     /// Converts `bvh`. An empty Bvh gives an empty tree, which collides with nothing.
@@ -51,6 +55,8 @@ public:
     [[nodiscard]] bool empty() const { return nodes_.empty(); }
     /// All nodes, root first, breadth-first as in the Bvh (model frame).
     [[nodiscard]] std::span<const QueryNode> nodes() const { return nodes_; }
+    /// The exact BV of node i (for a leaf: its primitive's geometry), as in the Bvh.
+    [[nodiscard]] const BoundingVolume& volume(std::uint32_t i) const { return volumes_[i]; }
     /// Leaf node index of each primitive, in input order.
     [[nodiscard]] std::span<const std::uint32_t> primitive_nodes() const { return primitive_nodes_; }
     /// Largest sum of child counts along a root-to-leaf path: this tree's share of the traversal stack.
@@ -58,6 +64,7 @@ public:
 
 private:
     std::vector<QueryNode> nodes_;
+    std::vector<BoundingVolume> volumes_;
     std::vector<std::uint32_t> primitive_nodes_;
     std::uint32_t stack_bound_ = 0;
 };
@@ -68,8 +75,10 @@ private:
 
 /// Tandem traversal (Erleben et al. 2005): from the root pair, expand the node with the larger volume
 /// (or the inner one, if the other is a leaf) and test its children against the other node; leaf pairs
-/// are exact primitive tests. pose_a / pose_b map each tree's model frame to the world. No allocation
-/// except growing `result.pairs` (and a heap stack for trees deeper than the built-in 256 entries).
+/// are exact primitive tests. Inner pairs are tested conservatively (enclosing spheres first; two boxes
+/// by the six face axes only), which never drops a pair but may expand a few more. pose_a / pose_b map
+/// each tree's model frame to the world. No allocation except growing `result.pairs` (and a heap stack
+/// when the two trees' stack bounds add up to more than the built-in 1024 entries).
 /// `result` is overwritten; reusing it across queries keeps the pairs' capacity.
 void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
              CollideMode mode, CollideResult& result);

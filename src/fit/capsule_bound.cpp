@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+// capsule_volume_lower_bound: diameter and smallest in-plane widths of the set (see the header's proof).
+#include "capsule_bound.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "hull_2d.hpp"
+
+namespace hbvh::detail {
+namespace {
+
+/// Smallest width of a convex polygon (counter-clockwise, no repeated points): attained perpendicular to
+/// one of its edges, so the widths across the edges are the only ones tried. O(h^2); h stays small.
+double min_width(const std::vector<Eigen::Vector2d>& hull) {
+    if (hull.size() < 3) return 0.0;  // a segment or a point has no width
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < hull.size(); ++i) {
+        const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
+        const double length = edge.norm();
+        if (!(length > 0.0)) continue;
+        const Eigen::Vector2d normal(-edge.y() / length, edge.x() / length);
+        double far = 0.0;
+        for (const Eigen::Vector2d& p : hull) far = std::max(far, std::abs((p - hull[i]).dot(normal)));
+        best = std::min(best, far);
+    }
+    return std::isfinite(best) ? best : 0.0;
+}
+
+/// Normals of the planes tried in a frame: its axes, and the diagonals of its faces and of the cube. For a
+/// box-like set with sides a >= b >= c along the frame, the plane containing a and the diagonal of b and
+/// c has smallest width min(a, (b + c) / sqrt 2), close to the sqrt(b^2 + c^2) a capsule along a needs;
+/// the frame's own planes only give b.
+const std::array<Vec3, 13>& plane_normals() {
+    static const std::array<Vec3, 13> normals = [] {
+        std::array<Vec3, 13> n{Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(0, 1, 1),  Vec3(0, 1, -1),
+                               Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(1, 1, 0),  Vec3(1, -1, 0), Vec3(1, 1, 1),
+                               Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(-1, 1, 1)};
+        for (Vec3& v : n) v.normalize();
+        return n;
+    }();
+    return normals;
+}
+
+}  // namespace
+
+double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3> planes, double enough) {
+    if (proxy.spheres.empty()) return 0.0;
+    // Relative to one centre, so that rounding scales with the set's size, not its distance from the origin.
+    const Vec3 origin = proxy.spheres.front().center;
+    double min_radius = std::numeric_limits<double>::infinity();
+    double max_radius = 0.0;
+    double diameter = 0.0;
+    for (std::size_t i = 0; i < proxy.spheres.size(); ++i) {
+        const Sphere& a = proxy.spheres[i];
+        min_radius = std::min(min_radius, a.radius);
+        max_radius = std::max(max_radius, a.radius);
+        diameter = std::max(diameter, 2.0 * a.radius);
+        for (std::size_t j = i + 1; j < proxy.spheres.size(); ++j) {
+            const Sphere& b = proxy.spheres[j];
+            diameter = std::max(diameter, (a.center - b.center).norm() + a.radius + b.radius);
+        }
+    }
+
+    auto volume_at = [&](double radius) {
+        const double length = std::max(0.0, diameter - 2.0 * radius);
+        return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
+    };
+    // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
+    // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
+    double radius = max_radius;
+    std::vector<Eigen::Vector2d> projected;
+    projected.reserve(proxy.hull_points.size());
+    for (const Mat3& frame : planes)
+        for (const Vec3& local_normal : plane_normals()) {
+            const Mat3 basis = frame_from_axis(frame * local_normal);
+            projected.clear();
+            for (const Vec3& p : proxy.hull_points) {
+                const Vec3 d = p - origin;
+                projected.emplace_back(d.dot(basis.col(1)), d.dot(basis.col(2)));
+            }
+            radius = std::max(radius, 0.5 * min_width(hull_2d(projected)) + min_radius);
+            // The bound only grows from here; once it is enough the other planes cannot change the answer.
+            if (volume_at(radius) >= enough) return volume_at(radius);
+        }
+    return volume_at(radius);
+}
+
+}  // namespace hbvh::detail

@@ -1,0 +1,45 @@
+// SPDX-License-Identifier: MIT
+// build() refuses inputs whose volumes overflow or underflow double precision, and only those.
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "hbvh/build/build.hpp"
+
+namespace hbvh {
+namespace {
+
+/// Two spheres of radius `size` `size` apart along every axis, so the world box is about 3 x size a side.
+std::vector<Primitive> two_spheres(double size) {
+    return {Primitive{Sphere{Vec3::Zero(), size}, "a"}, Primitive{Sphere{Vec3::Constant(size), size}, "b"}};
+}
+
+TEST(InputRange, OrdinaryScalesAreAccepted) {
+    for (double size : {1e-90, 1e-3, 1.0, 1e3, 1e90}) {
+        EXPECT_TRUE(check_finite_extent(two_spheres(size)).has_value()) << size;
+        EXPECT_TRUE(build(two_spheres(size), Algorithm::optimal).has_value()) << size;
+    }
+}
+
+TEST(InputRange, OverflowIsRefusedWithAMessage) {
+    const Status checked = check_finite_extent(two_spheres(1e120));
+    ASSERT_FALSE(checked.has_value());
+    EXPECT_NE(checked.error().message.find("overflow"), std::string::npos);
+    // Every builder refuses, the exact ones included (optimal used to run for minutes on such input).
+    for (const AlgorithmInfo& info : algorithms())
+        EXPECT_FALSE(build(two_spheres(1e120), info.algorithm).has_value()) << info.name;
+}
+
+TEST(InputRange, UnderflowIsRefusedButAFlatModelIsNot) {
+    const Status checked = check_finite_extent(two_spheres(1e-120));
+    ASSERT_FALSE(checked.has_value());
+    EXPECT_NE(checked.error().message.find("underflow"), std::string::npos);
+    // Boxes in one plane: the world box has zero height, its volume is truly zero, nothing underflows.
+    const Aabb flat_a{Vec3(0, 0, 0), Vec3(1, 1, 0)};
+    const Aabb flat_b{Vec3(2, 0, 0), Vec3(3, 1, 0)};
+    const std::vector<Primitive> flat{Primitive{flat_a, "a"}, Primitive{flat_b, "b"}};
+    EXPECT_TRUE(check_finite_extent(flat).has_value());
+}
+
+}  // namespace
+}  // namespace hbvh
