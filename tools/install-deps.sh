@@ -11,7 +11,7 @@ packages=(
   libmujoco-dev libmujoco-samples liburdfdom-dev libassimp-dev
   libbullet-dev libfcl-dev graphviz
   chromium
-  clang libclang-rt-14-dev
+  clang-16 libclang-rt-16-dev
 )
 missing=()
 # Node may come from elsewhere than Debian (its npm then comes with it): ask Debian only when absent.

@@ -1,10 +1,25 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Installs, builds everything with warnings as errors and assertions on, and runs the whole test suite.
+# The README's test command and what CI runs: installs, builds everything with warnings as errors, assertions on
+# and AddressSanitizer + UndefinedBehaviorSanitizer, runs the whole test suite under the sanitizers, then runs
+# each libFuzzer target briefly (tools/fuzz.sh). Usage: tools/test.sh [fuzz seconds per target, default 12]
 set -euo pipefail
 cd "$(dirname "$0")/.."
+fuzz_seconds="${1:-12}"
+phase() { printf '== %s (%s s since start)\n' "$1" "$SECONDS"; }
+
+phase "install dependencies"
 bash tools/install-deps.sh
+phase "build (gcc, ASan + UBSan)"
 cmake -S . -B build-test -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DHBVH_WARNINGS_AS_ERRORS=ON -DHBVH_ENABLE_ASSERTS=ON >/dev/null
+  -DHBVH_WARNINGS_AS_ERRORS=ON -DHBVH_ENABLE_ASSERTS=ON -DHBVH_SANITIZE=ON >/dev/null
 cmake --build build-test
+phase "test suite under the sanitizers"
+# The first report is fatal, so ctest sees it; leaks fail too, except inside assimp and urdfdom (fuzz/lsan.supp).
+export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=1}"
+export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 ctest --test-dir build-test --output-on-failure -j2
+phase "fuzz (${fuzz_seconds} s per target)"
+bash tools/fuzz.sh "$fuzz_seconds"
+phase "done"

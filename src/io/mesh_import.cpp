@@ -3,8 +3,13 @@
 #include "hbvh/io/mesh_import.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <limits>
 #include <regex>
+#include <sstream>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -37,8 +42,12 @@ struct MeshInstance {
 int line_in(const std::string& message) {
     static const std::regex line_pattern(R"(line[ :]+(\d+))", std::regex::icase);
     std::smatch match;
-    if (std::regex_search(message, match, line_pattern)) return std::stoi(match[1].str());
-    return 0;
+    if (!std::regex_search(message, match, line_pattern)) return 0;
+    // Messages can quote the file's own text, so the digits may not fit an int (std::stoi would throw).
+    int line = 0;
+    const std::string digits = match[1].str();
+    const auto [end, code] = std::from_chars(digits.data(), digits.data() + digits.size(), line);
+    return code == std::errc() && end == digits.data() + digits.size() ? line : 0;
 }
 
 Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatrix4x4& parent_transform,
@@ -69,11 +78,79 @@ Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatri
     return Ok{};
 }
 
+// Whether a fitted volume has positive size in every dimension the survey format writes (sphere and capsule
+// radius, every box extent). Vertices that all coincide, or lie on a line or in a plane, fit volumes with a zero
+// size, which the XML reader (rightly) refuses, so they would make files hbvh cannot read back.
+bool has_positive_size(const BoundingVolume& volume) {
+    if (const auto* sphere = std::get_if<Sphere>(&volume)) return sphere->radius > 0.0;
+    if (const auto* capsule = std::get_if<Capsule>(&volume)) return capsule->radius > 0.0;
+    if (const auto* box = std::get_if<Obb>(&volume)) return (box->half_extents.array() > 0.0).all();
+    const Aabb& box = std::get<Aabb>(volume);
+    return (box.max.array() > box.min.array()).all();
+}
+
+// assimp's PLY reader (5.2) hangs on a header without end_header, and trusts the header's element counts:
+// "element vertex 99999999999" in an 80-byte file makes it loop and allocate for minutes. Every element instance takes at least one byte per property (one
+// byte for a property-less element), in ASCII and binary alike, so a header that declares more than the rest of
+// the file can hold is refused before assimp sees it, as is a header without end_header.
+Status check_ply_header(const std::string& path) {
+    std::ifstream stream(path, std::ios::binary);
+    // assimp takes any file starting with these three letters as PLY, whatever follows them on the line.
+    char magic[3] = {};
+    if (!stream.read(magic, 3) || std::string_view(magic, 3) != "ply") return Ok{};
+    stream.seekg(0, std::ios::end);
+    const auto file_size = static_cast<std::uint64_t>(stream.tellg());
+    stream.seekg(0);
+    constexpr std::uint64_t saturated = std::numeric_limits<std::uint64_t>::max() / 2;
+    std::uint64_t needed = 0;           // Bytes the declared elements take at least.
+    std::uint64_t element_count = 0;    // Instances of the element being declared.
+    std::uint64_t property_count = 0;   // Its properties so far.
+    auto close_element = [&] {
+        const std::uint64_t per_instance = std::max<std::uint64_t>(1, property_count);
+        needed = element_count > (saturated - needed) / per_instance ? saturated : needed + element_count * per_instance;
+    };
+    std::string line;
+    int line_number = 0;
+    while (std::getline(stream, line)) {
+        ++line_number;
+        std::istringstream words(line);
+        std::string keyword;
+        words >> keyword;
+        if (keyword == "element") {
+            close_element();
+            std::string name, count;
+            words >> name >> count;
+            // Saturate instead of failing on overlong numbers: assimp reads them too, and the size check below
+            // then refuses the file.
+            element_count = 0;
+            for (const char digit : count) {
+                if (digit < '0' || digit > '9') break;
+                element_count = std::min(saturated, element_count * 10 + static_cast<std::uint64_t>(digit - '0'));
+            }
+            property_count = 0;
+        } else if (keyword == "property") {
+            ++property_count;
+        } else if (keyword == "end_header") {
+            close_element();
+            const auto header_end = static_cast<std::uint64_t>(stream.tellg());
+            const std::uint64_t body = stream.eof() || header_end > file_size ? 0 : file_size - header_end;
+            if (needed > body)
+                return Error("PLY header declares elements needing at least " + std::to_string(needed) +
+                                 " bytes, but only " + std::to_string(body) + " follow the header",
+                             path, line_number);
+            return Ok{};
+        }
+    }
+    // assimp 5.2 never stops looking for the end of such a header.
+    return Error("PLY header has no end_header line", path, line_number);
+}
+
 }  // namespace
 
 Result<ImportResult> import_mesh(const std::string& path, const MeshImportOptions& options) {
     // Only positions are needed: no normals, no triangulation. Assimp has no logger unless one is created, so it
     // stays silent.
+    if (Status header = check_ply_header(path); !header) return header.error();
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     if (scene == nullptr || scene->mRootNode == nullptr) {
@@ -111,6 +188,14 @@ Result<ImportResult> import_mesh(const std::string& path, const MeshImportOption
             case CollisionKind::capsule: volume = fit_capsule(instance.points); break;
             case CollisionKind::convex:
             case CollisionKind::none: volume = fit_best(instance.points, options.policy); break;
+        }
+        if (!has_positive_size(volume)) {
+            // Like URDF's zero-size placeholders: nothing to collide with, so skipped rather than fatal.
+            result.warnings.push_back(Error("mesh '" + instance.name + "' is flat or a single point (its " +
+                                                std::string(to_string(type_of(volume))) + " has a zero size); skipped",
+                                            path)
+                                          .to_string());
+            continue;
         }
         result.primitives.push_back({std::move(volume), instance.name});
     }

@@ -94,6 +94,10 @@ private:
             if (depth >= max_include_depth) return here.error_at(child, "includes nested too deeply (a cycle?)");
             std::filesystem::path included = file;
             if (included.is_relative()) included = base_directory_ / included;
+            // The name comes from the file, so it may be /dev/zero, /dev/stdin or a FIFO, which would never end.
+            std::error_code ignored;
+            if (std::filesystem::exists(included, ignored) && !std::filesystem::is_regular_file(included, ignored))
+                return here.error_at(child, "cannot include '" + std::string(file) + "': not a regular file");
             Result<std::unique_ptr<XmlSource>> loaded = XmlSource::load(included.string());
             if (!loaded) {
                 // Report where the include is, and why the included file failed.
@@ -445,6 +449,8 @@ private:
         } else {
             volume = enclose_ellipsoid(world, Vec3(size[0], size[1], size[2]));
         }
+        if (!detail::is_representable(volume))
+            return error_at(geom, type + " geom '" + name + "' is too large: its position or size overflows double");
         result_.primitives.push_back({std::move(volume), name});
         return Ok{};
     }

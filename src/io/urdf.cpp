@@ -117,9 +117,14 @@ public:
                 return source_->error_at(link_element, "urdfdom read a different number of collisions");
             for (std::size_t i = 0; i < sites.size(); ++i) {
                 const std::string fallback = link_name + "_collision" + std::to_string(i);
+                const std::size_t before = result_.primitives.size();
                 if (Status status = add_collision(*link->collision_array[i], sites[i], world_from_link, fallback);
                     !status)
                     return status.error();
+                // Sizes near the limit of double, or origins composed along a chain, can overflow.
+                if (result_.primitives.size() > before && !detail::is_representable(result_.primitives.back().volume))
+                    return source_->error_at(sites[i].element, "collision '" + result_.primitives.back().name +
+                                                                   "' is too large: its position or size overflows double");
             }
         }
         return std::move(result_);

@@ -43,6 +43,19 @@ int XmlSource::line_of_offset(std::ptrdiff_t offset) const {
     return static_cast<int>(std::distance(line_starts_.begin(), after));
 }
 
+bool is_representable(const BoundingVolume& volume) {
+    if (const auto* sphere = std::get_if<Sphere>(&volume))
+        return sphere->center.allFinite() && std::isfinite(sphere->radius);
+    if (const auto* capsule = std::get_if<Capsule>(&volume))
+        return capsule->p0.allFinite() && capsule->p1.allFinite() && std::isfinite(capsule->radius) &&
+               std::isfinite(capsule->length()) && capsule->center().allFinite();
+    if (const auto* box = std::get_if<Obb>(&volume))
+        return box->center.allFinite() && box->rotation.allFinite() && Vec3(2.0 * box->half_extents).allFinite();
+    const Aabb& box = std::get<Aabb>(volume);
+    return box.min.allFinite() && box.max.allFinite() && Vec3(box.max - box.min).allFinite() &&
+           box.center().allFinite();
+}
+
 std::optional<std::vector<double>> parse_numbers(std::string_view text) {
     std::vector<double> values;
     std::size_t i = 0;

@@ -11,6 +11,7 @@
 
 #include <pugixml.hpp>
 
+#include "hbvh/geometry/bounding_volume.hpp"
 #include "hbvh/result.hpp"
 
 namespace hbvh::detail {
@@ -43,6 +44,11 @@ private:
     std::vector<std::size_t> line_starts_;
     pugi::xml_document document_;
 };
+
+/// Whether `volume` can be written to the survey format and read back: every coordinate finite, and every size the
+/// format stores (full box extents, capsule length, radius) finite too. Near the limit of double a half size can be
+/// finite while the full size overflows, and a position composed through several frames can overflow.
+[[nodiscard]] bool is_representable(const BoundingVolume& volume);
 
 /// Reads the whole file as bytes; nullopt when it cannot be opened.
 [[nodiscard]] std::optional<std::string> read_file_bytes(const std::string& path);
