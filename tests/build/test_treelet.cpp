@@ -99,7 +99,9 @@ TEST(Treelet, RespectsThePolicy) {
     EXPECT_TRUE(validate(refined).has_value());
     EXPECT_LE(cost(refined, spheres_only), cost(*built, spheres_only) * (1.0 + 1e-12));
     for (const Node& node : refined.nodes) {
-        if (!node.is_leaf()) EXPECT_EQ(type_of(node.volume), BvType::sphere);
+        if (!node.is_leaf()) {
+            EXPECT_EQ(type_of(node.volume), BvType::sphere);
+        }
     }
 }
 
