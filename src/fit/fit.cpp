@@ -3,6 +3,9 @@
 // sphere.cpp, obb.cpp and capsule.cpp.
 #include "hbvh/fit/fit.hpp"
 
+#include <algorithm>
+#include <array>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <vector>
@@ -50,8 +53,37 @@ BoundingVolume fit(BvType type, std::span<const Sphere> spheres, std::span<const
     return fit_aabb(spheres);
 }
 
+namespace {
+/// `spheres` without exact repeats, first occurrences in their original order; empty when there are none
+/// to drop. Repeats change no BV, but degenerate sets (10^5 copies of one sphere: a flat hull, a zero
+/// covariance) sent the hull and search steps down slow paths whose cost grew with the copies.
+std::vector<Sphere> without_repeats(std::span<const Sphere> spheres) {
+    std::vector<std::uint32_t> order(spheres.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    const auto key = [&](std::uint32_t i) {
+        const Sphere& s = spheres[i];
+        return std::array{s.center.x(), s.center.y(), s.center.z(), s.radius};
+    };
+    std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    std::vector<bool> repeat(spheres.size(), false);
+    bool any = false;
+    for (std::size_t i = 1; i < order.size(); ++i)
+        if (key(order[i]) == key(order[i - 1])) repeat[order[i]] = any = true;
+    std::vector<Sphere> kept;
+    if (!any) return kept;
+    for (std::size_t i = 0; i < spheres.size(); ++i)
+        if (!repeat[i]) kept.push_back(spheres[i]);
+    return kept;
+}
+}  // namespace
+
 BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& policy, std::span<const Mat3> hint_axes) {
     HBVH_ASSERT(!spheres.empty());
+    // Small sets are fitted as they are: the check would cost more than the repeats it could save.
+    if (spheres.size() > 256) {
+        const std::vector<Sphere> distinct = without_repeats(spheres);
+        if (!distinct.empty()) return fit_best(distinct, policy, hint_axes);
+    }
     // The OBB and capsule fitters need the same hull, proxy, DiTO frames and hints, and the capsule
     // fitter needs the enclosing sphere: compute each once, and only when some allowed kind needs it.
     // The results are bit for bit those of the separate fitters.

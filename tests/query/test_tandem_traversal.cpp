@@ -191,15 +191,25 @@ Work check_builder(const std::string& name, const std::function<Bvh(std::span<co
     return work;
 }
 
-TEST(TandemTraversal, MatchesBruteForceForEveryAlgorithm) {
-    for (const AlgorithmInfo& info : algorithms()) {
-        check_builder(std::string(info.name), [&](std::span<const Primitive> primitives, std::uint64_t) {
-            auto built = build(primitives, info.algorithm);
-            HBVH_ASSERT(built.has_value());
-            return std::move(built).value();
-        });
-    }
+/// One CTest entry per builder, so that the slow builders' cases run in parallel with the rest.
+class TandemTraversalPerBuilder : public testing::TestWithParam<AlgorithmInfo> {};
+
+TEST_P(TandemTraversalPerBuilder, MatchesBruteForce) {
+    const AlgorithmInfo& info = GetParam();
+    check_builder(std::string(info.name), [&](std::span<const Primitive> primitives, std::uint64_t) {
+        auto built = build(primitives, info.algorithm);
+        HBVH_ASSERT(built.has_value());
+        return std::move(built).value();
+    });
 }
+
+INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, TandemTraversalPerBuilder,
+                         testing::ValuesIn(algorithms().begin(), algorithms().end()),
+                         [](const testing::TestParamInfo<AlgorithmInfo>& param) {
+                             std::string name(param.param.name);
+                             std::replace(name.begin(), name.end(), '-', '_');
+                             return name;
+                         });
 
 TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
     const Work work = check_builder("deep-mixed", build_deep_mixed);
