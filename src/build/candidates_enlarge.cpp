@@ -13,13 +13,6 @@
 namespace hbvh {
 namespace {
 
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
-
 /// The last step worth trying for a BV: the first k whose scaled world AABB holds the level's bounds
 /// ("the enlarged BV spans the whole level"), capped by `max_steps` for BVs flat along some axis.
 std::uint32_t last_step(const BoundingVolume& bv, const Aabb& level_bounds, const EnlargeOptions& options) {

@@ -5,13 +5,6 @@
 
 namespace hbvh {
 namespace {
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
-
 constexpr std::array<std::string_view, bv_type_count> type_names{"aabb", "obb", "sphere", "capsule"};
 }  // namespace
 

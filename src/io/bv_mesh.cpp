@@ -164,13 +164,6 @@ TriangleMesh swept_sphere_mesh(const Vec3& p0, const Vec3& p1, double radius, co
     return mesh;
 }
 
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
-
 }  // namespace
 
 TriangleMesh triangulate(const BoundingVolume& bv, const MeshDetail& detail) {

@@ -18,13 +18,6 @@
 namespace hbvh {
 namespace {
 
-template <class... Ts>
-struct Overloaded : Ts... {
-    using Ts::operator()...;
-};
-template <class... Ts>
-Overloaded(Ts...) -> Overloaded<Ts...>;
-
 // The attributes each type takes besides type, name and pos/position. Everything else is rejected:
 // silently ignoring a misspelt `orientaton` would turn an OBB into an AABB without a word.
 constexpr std::array<std::string_view, 3> box_attributes{"width", "depth", "height"};

@@ -20,6 +20,14 @@ namespace hbvh {
 /// The index order matches BvType.
 using BoundingVolume = std::variant<Aabb, Obb, Sphere, Capsule>;
 
+/// Lambdas joined into one visitor, for std::visit over a BoundingVolume with one lambda per kind.
+template <class... Ts>
+struct Overloaded : Ts... {
+    using Ts::operator()...;
+};
+template <class... Ts>
+Overloaded(Ts...) -> Overloaded<Ts...>;
+
 /// The kind of a BoundingVolume, in variant order.
 enum class BvType : std::uint8_t { aabb = 0, obb = 1, sphere = 2, capsule = 3 };
 inline constexpr std::size_t bv_type_count = 4;
