@@ -2,10 +2,10 @@
 # SPDX-License-Identifier: MIT
 # The README's test command and what CI runs: installs, builds everything with warnings as errors, assertions on
 # and AddressSanitizer + UndefinedBehaviorSanitizer, runs the whole test suite under the sanitizers, then runs
-# each libFuzzer target briefly (tools/fuzz.sh). Usage: tools/test.sh [fuzz seconds per target, default 12]
+# each libFuzzer target briefly (tools/fuzz.sh). Usage: tools/test.sh [--ci (default: fixed seed and inputs) or fuzz seconds per target]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-fuzz_seconds="${1:-12}"
+fuzz_mode="${1:---ci}"
 phase() { printf '== %s (%s s since start)\n' "$1" "$SECONDS"; }
 
 phase "install dependencies"
@@ -20,6 +20,6 @@ export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp:print_supp
 export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=1}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 ctest --test-dir build-test --output-on-failure -j2
-phase "fuzz (${fuzz_seconds} s per target)"
-bash tools/fuzz.sh "$fuzz_seconds"
+phase "fuzz ($fuzz_mode)"
+bash tools/fuzz.sh "$fuzz_mode"
 phase "done"

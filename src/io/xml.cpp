@@ -14,6 +14,7 @@
 
 #include "hbvh/assert.hpp"
 #include "hbvh/io/file.hpp"
+#include "xml_source.hpp"
 
 namespace hbvh {
 namespace {
@@ -166,6 +167,10 @@ Result<XmlModel> Reader::run() {
         std::string name;
         Result<BoundingVolume> volume = read_volume(element, name);
         if (!volume) return volume.error();
+        // Each number can be finite while what is derived from them is not (a box's centre from corners near
+        // 1e308, a capsule's length beyond 1e154); such a volume could not be written back or fitted.
+        if (!detail::is_representable(*volume))
+            return error(line_of(element), "volume's centre, length or extents overflow the range of double");
         const auto index = static_cast<std::uint32_t>(items.size());
         items.push_back({std::move(volume).value(), std::move(name), {}});
         if (parent != no_parent) items[parent].children.push_back(index);
