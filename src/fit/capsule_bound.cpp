@@ -74,6 +74,7 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
     double radius = max_radius;
     std::vector<Eigen::Vector2d> projected;
+    std::vector<Eigen::Vector2d> hull;
     projected.reserve(proxy.hull_points.size());
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
@@ -83,7 +84,8 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
                 const Vec3 d = p - origin;
                 projected.emplace_back(d.dot(basis.col(1)), d.dot(basis.col(2)));
             }
-            radius = std::max(radius, 0.5 * min_width(hull_2d(projected)) + min_radius);
+            hull_2d(projected, hull);
+            radius = std::max(radius, 0.5 * min_width(hull) + min_radius);
             // The bound only grows from here; once it is enough the other planes cannot change the answer.
             if (volume_at(radius) >= enough) return volume_at(radius);
         }

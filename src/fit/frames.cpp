@@ -206,14 +206,16 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     std::vector<Mat3> frames;
     frames.reserve(normals.size());
     const double pad = 2.0 * proxy.max_radius;
+    std::vector<Eigen::Vector2d> projected;
+    std::vector<Eigen::Vector2d> hull;
+    projected.reserve(proxy.hull_points.size());
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
-        std::vector<Eigen::Vector2d> projected;
         // Every centre lies in the hull of the hull-vertex centres, so their projections span the same
         // 2-D hull: sorting only those keeps this O(hull size) per normal even when many spheres are kept.
-        projected.reserve(proxy.hull_points.size());
+        projected.clear();
         for (const Vec3& p : proxy.hull_points) projected.emplace_back(p.dot(basis.col(1)), p.dot(basis.col(2)));
-        const std::vector<Eigen::Vector2d> hull = hull_2d(std::move(projected));
+        hull_2d(projected, hull);
         // Try each hull edge as a rectangle side; O(h^2) in the 2-D hull size, which stays small.
         Eigen::Vector2d best_direction(1.0, 0.0);
         double best_area = infinity;

@@ -6,14 +6,17 @@
 
 namespace hbvh::detail {
 
-std::vector<Eigen::Vector2d> hull_2d(std::vector<Eigen::Vector2d> points) {
+void hull_2d(std::vector<Eigen::Vector2d>& points, std::vector<Eigen::Vector2d>& hull) {
     std::sort(points.begin(), points.end(),
               [](const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
-    if (points.size() < 3) return points;
+    if (points.size() < 3) {
+        hull = points;
+        return;
+    }
     auto turn = [](const Eigen::Vector2d& o, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
         return (a.x() - o.x()) * (b.y() - o.y()) - (a.y() - o.y()) * (b.x() - o.x());
     };
-    std::vector<Eigen::Vector2d> hull(2 * points.size());
+    hull.resize(2 * points.size());
     std::size_t k = 0;
     for (std::size_t i = 0; i < points.size(); ++i) {
         while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
@@ -24,7 +27,6 @@ std::vector<Eigen::Vector2d> hull_2d(std::vector<Eigen::Vector2d> points) {
         hull[k++] = points[i];
     }
     hull.resize(k - 1);
-    return hull;
 }
 
 }  // namespace hbvh::detail

@@ -62,8 +62,9 @@ hbvh_cli_rejects_import(urdf_wrong_root.urdf "urdf_wrong_root.urdf:1: root eleme
 hbvh_cli_rejects_import(mesh_nan_vertex.obj "mesh_nan_vertex.obj: mesh 'UBX_box' has a vertex that is not finite")
 hbvh_cli_rejects_import(mesh_render_only.obj "mesh_render_only.obj: no collision meshes")
 hbvh_cli_rejects_import(mesh_bad_header.ply "mesh_bad_header.ply:5: PLY header declares")
-# A single-point collision piece is skipped (zero size); with nothing else left, that is exit 1.
-hbvh_cli_rejects_import(mesh_one_point_sphere.obj "mesh_one_point_sphere.obj: the file holds no collision primitives")
+# A single-point collision piece is skipped (zero size); with nothing else left, that is exit 1, and the message
+# says why the piece was skipped.
+hbvh_cli_rejects_import(mesh_one_point_sphere.obj "mesh_one_point_sphere.obj: the file holds no collision primitives: .*mesh 'USP_point' is flat or a single point")
 
 # Degenerate but valid geometry: accepted, exit 0.
 foreach(input one_primitive duplicates flat_boxes mixed_scale)

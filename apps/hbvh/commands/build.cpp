@@ -39,8 +39,12 @@ std::string bound_summary(const BuildReport& report, double cost) {
 }
 
 void print_report(const BuildReport& report, double seconds, double cost) {
-    fmt::print(stderr, "{:>5} {:>7} {:>10} {:>13} {:>7} {:>11}  notes\n", "level", "nodes", "candidates", "solver-nodes",
-               "groups", "time-ms");
+    // Insertion, splitting and merging build no levels; a header over no rows would look like a failure.
+    if (report.levels.empty())
+        fmt::print(stderr, "levels: none reported (the builder that made this tree does not work level by level)\n");
+    else
+        fmt::print(stderr, "{:>5} {:>7} {:>10} {:>13} {:>7} {:>11}  notes\n", "level", "nodes", "candidates",
+                   "solver-nodes", "groups", "time-ms");
     for (std::size_t i = 0; i < report.levels.size(); ++i) {
         const LevelReport& level = report.levels[i];
         fmt::print(stderr, "{:>5} {:>7} {:>10} {:>13} {:>7} {:>11.3f}  {}{}\n", i, level.nodes, level.candidates,

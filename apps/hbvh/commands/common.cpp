@@ -57,7 +57,16 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
     }
     Result<ImportResult> imported = import_primitives(path, chosen->second);
     if (!imported) return imported.error();
-    if (imported->primitives.empty()) return Error{"the file holds no collision primitives", path};
+    if (imported->primitives.empty()) {
+        // The importer's warnings say why each candidate was skipped (mesh geoms, unnamed meshes, ...); the
+        // error is all the user will see, so it carries them.
+        std::string message = "the file holds no collision primitives";
+        const std::vector<std::string>& skipped = imported->warnings;
+        constexpr std::size_t shown = 3;
+        for (std::size_t i = 0; i < std::min(skipped.size(), shown); ++i) message += (i == 0 ? ": " : "; ") + skipped[i];
+        if (skipped.size() > shown) message += "; and " + std::to_string(skipped.size() - shown) + " more";
+        return Error{message, path};
+    }
     return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
 }
 }  // namespace
