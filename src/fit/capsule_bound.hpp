@@ -13,7 +13,8 @@ namespace hbvh::detail {
 /// A lower bound on the volume of every capsule containing the proxy's spheres. `planes` are frames
 /// whose coordinate planes are tried as cross-sections (any frames are valid; the axes of a tight box
 /// around the set give the strongest bound). Proof sketch, for a capsule of radius r and length L:
-///  * its diameter is L + 2r, so L + 2r >= D, the set's diameter;
+///  * its diameter is L + 2r, so L + 2r >= D, the set's diameter (or any lower bound of it: large sets use
+///    the farthest pair among extremal spheres);
 ///  * every plane P through the origin contains a direction u perpendicular to the capsule's axis, and
 ///    the capsule's width along such a u is 2r, so 2r >= the smallest width of the set along P;
 ///  * the volume pi r^2 L + 4/3 pi r^3 >= pi r^2 max(0, D - 2r) + 4/3 pi r^3, which grows with r.

@@ -13,49 +13,22 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/tree_properties.hpp"
 
 namespace hbvh {
 namespace {
 
-std::vector<Primitive> scene(std::uint32_t count, std::uint64_t seed, bool clustered = true) {
-    SceneOptions options;
-    options.count = count;
-    options.seed = seed;
-    options.clustered = clustered;
-    return generate_scene(options);
-}
-
-// Every primitive in exactly one leaf, no inner node with one child, and every node's BV contains the
-// generating spheres of every primitive it covers (relative tolerance 1e-9 of the node's size).
-void check_properties(const std::vector<Primitive>& primitives, const Bvh& bvh) {
-    ASSERT_EQ(bvh.primitives.size(), primitives.size());
-    std::vector<int> seen(primitives.size(), 0);
-    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
-        const Node& node = bvh.nodes[i];
-        if (node.is_leaf()) {
-            ASSERT_LT(node.primitive, primitives.size());
-            ++seen[node.primitive];
-            continue;
-        }
-        EXPECT_GE(node.child_count, 2u) << "node " << i;
-        const double tolerance = 1e-9 * size_scale(node.volume);
-        for (const std::uint32_t p : covered_primitives(bvh, i))
-            for (const Sphere& s : generating_spheres(primitives[p].volume))
-                ASSERT_TRUE(contains(node.volume, s, tolerance)) << "node " << i << " misses primitive " << p;
-    }
-    for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
-    const Status valid = validate(bvh);
-    EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
-}
+using test_support::expect_tree_properties;
+using test_support::generated_scene;
 
 TEST(Scale, PropertiesOnGeneratedScenes) {
     for (std::uint32_t count : {1u, 2u, 3u, 4u, 5u, 7u, 33u, 100u, 257u, 1000u, 5000u}) {
         for (bool clustered : {true, false}) {
             SCOPED_TRACE(std::to_string(count) + (clustered ? " clustered" : " uniform"));
-            const std::vector<Primitive> primitives = scene(count, 100 + count, clustered);
+            const std::vector<Primitive> primitives = generated_scene(count, 100 + count, clustered);
             BuildReport report;
             const Bvh bvh = build_scale(primitives, VolumePolicy::all(), {}, &report);
-            check_properties(primitives, bvh);
+            expect_tree_properties(primitives, bvh);
             if (count > 1) {
                 EXPECT_FALSE(report.levels.empty());
             }
@@ -65,12 +38,12 @@ TEST(Scale, PropertiesOnGeneratedScenes) {
 }
 
 TEST(Scale, PropertiesWithRestrictedPolicies) {
-    const std::vector<Primitive> primitives = scene(600, 7);
+    const std::vector<Primitive> primitives = generated_scene(600, 7);
     for (BvType type : all_bv_types) {
         SCOPED_TRACE(std::string(to_string(type)));
         const VolumePolicy policy = VolumePolicy::only(type);
         const Bvh bvh = build_scale(primitives, policy);
-        check_properties(primitives, bvh);
+        expect_tree_properties(primitives, bvh);
         for (const Node& node : bvh.nodes)
             if (!node.is_leaf()) {
                 EXPECT_EQ(type_of(node.volume), type);
@@ -79,7 +52,7 @@ TEST(Scale, PropertiesWithRestrictedPolicies) {
 }
 
 TEST(Scale, SameHierarchyForOneAndTwoThreads) {
-    const std::vector<Primitive> primitives = scene(3000, 42);
+    const std::vector<Primitive> primitives = generated_scene(3000, 42);
     const auto build_with = [&](std::size_t threads) {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
         return build_scale(primitives, VolumePolicy::all());
@@ -110,7 +83,7 @@ TEST(Scale, SameHierarchyForOneAndTwoThreads) {
 TEST(Scale, NoWorseThanMergeAndRatioToSplitRecorded) {
     for (const auto& [count, seed] : {std::pair{1000u, 5u}, std::pair{1500u, 6u}}) {
         SCOPED_TRACE(std::to_string(count));
-        const std::vector<Primitive> primitives = scene(count, seed);
+        const std::vector<Primitive> primitives = generated_scene(count, seed);
         const double scale_cost = cost(build_scale(primitives, VolumePolicy::all()));
         Result<Bvh> merged = build(primitives, Algorithm::merge);
         ASSERT_TRUE(merged.has_value());
@@ -125,19 +98,19 @@ TEST(Scale, ReportsProgressUpToOne) {
     std::vector<double> fractions;
     ScaleOptions options;
     options.progress = [&](double f) { fractions.push_back(f); };
-    (void)build_scale(scene(500, 3), VolumePolicy::all(), options);
+    (void)build_scale(generated_scene(500, 3), VolumePolicy::all(), options);
     ASSERT_FALSE(fractions.empty());
     for (std::size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1]);
     EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
 }
 
 TEST(Scale, TimeLimitStillGivesAValidTree) {
-    const std::vector<Primitive> primitives = scene(2000, 9);
+    const std::vector<Primitive> primitives = generated_scene(2000, 9);
     ScaleOptions options;
     options.time_limit_seconds = 1e-6;  // past at once: every window keeps its initial cover
     BuildReport report;
     const Bvh bvh = build_scale(primitives, VolumePolicy::all(), options, &report);
-    check_properties(primitives, bvh);
+    expect_tree_properties(primitives, bvh);
     EXPECT_TRUE(report.budget_hit);
 }
 
@@ -149,13 +122,13 @@ TEST(Auto, PicksBySizeAndSaysSo) {
     EXPECT_EQ(auto_choice(auto_exact_max_primitives + 1), Algorithm::scale);
     ASSERT_EQ(parse_algorithm("auto"), Algorithm::automatic);
     for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_exact_max_primitives + 10}) {
-        const std::vector<Primitive> primitives = scene(count, count);
+        const std::vector<Primitive> primitives = generated_scene(count, count);
         BuildReport report;
         BuildOptions options;
         options.report = &report;
         Result<Bvh> built = build(primitives, Algorithm::automatic, options);
         ASSERT_TRUE(built.has_value());
-        check_properties(primitives, built.value());
+        expect_tree_properties(primitives, built.value());
         // One note names the portfolio (auto_choice is its first member) and the builder kept.
         const auto said = std::find_if(report.notes.begin(), report.notes.end(), [&](const std::string& note) {
             return note.starts_with("auto:") &&

@@ -13,6 +13,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/tree_properties.hpp"
 
 
 namespace hbvh {
@@ -32,34 +33,11 @@ Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorit
     EXPECT_TRUE(built.has_value()) << (built.has_value() ? "" : built.error().to_string());
     if (!built.has_value()) return {};
     const Bvh& bvh = built.value();
-    EXPECT_EQ(bvh.primitives.size(), primitives.size());
-    std::vector<int> seen(primitives.size(), 0);
-    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
-        const Node& node = bvh.nodes[i];
-        if (node.is_leaf()) {
-            EXPECT_LT(node.primitive, primitives.size());
-            if (node.primitive < primitives.size()) ++seen[node.primitive];
-            continue;
-        }
-        EXPECT_GE(node.child_count, 2u) << "node " << i;
-        const double tolerance = 1e-9 * size_scale(node.volume);
-        for (const std::uint32_t p : covered_primitives(bvh, i))
-            for (const Sphere& s : generating_spheres(primitives[p].volume))
-                EXPECT_TRUE(contains(node.volume, s, tolerance)) << "node " << i << " misses primitive " << p;
-    }
-    for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
-    const Status valid = validate(bvh);
-    EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
+    test_support::expect_tree_properties(primitives, bvh);
     return bvh;
 }
 
-std::vector<Primitive> scene(std::uint32_t count, std::uint64_t seed, bool clustered = true) {
-    SceneOptions options;
-    options.count = count;
-    options.seed = seed;
-    options.clustered = clustered;
-    return generate_scene(options);
-}
+using test_support::generated_scene;
 
 std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
     SplitMix64 random(seed);
@@ -78,7 +56,7 @@ class EveryHeuristic : public testing::TestWithParam<Algorithm> {};
 
 TEST_P(EveryHeuristic, PropertiesOnGeneratedScenesOfEverySize) {
     for (std::uint32_t count = 1; count <= 60; ++count)
-        check_properties(scene(count, 1000 + count, count % 2 == 0), GetParam());
+        check_properties(generated_scene(count, 1000 + count, count % 2 == 0), GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(SurveyHeuristics, EveryHeuristic, testing::ValuesIn(heuristic_builders),
@@ -89,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(SurveyHeuristics, EveryHeuristic, testing::ValuesIn(heu
                          });
 
 TEST(SurveyHeuristics, PropertiesUnderRestrictedPolicies) {
-    const std::vector<Primitive> primitives = scene(40, 7);
+    const std::vector<Primitive> primitives = generated_scene(40, 7);
     for (const BvType only : all_bv_types) {
         BuildOptions options;
         options.policy = VolumePolicy::only(only);
@@ -117,7 +95,7 @@ TEST(SurveyHeuristics, DegenerateInputs) {
 }
 
 TEST(SurveyHeuristics, MergeBranchingFactorIsAnOption) {
-    const std::vector<Primitive> primitives = scene(50, 11);
+    const std::vector<Primitive> primitives = generated_scene(50, 11);
     for (const std::uint32_t factor : {2u, 3u, 4u, 8u}) {
         BuildOptions options;
         options.merge.branching_factor = factor;
@@ -128,7 +106,7 @@ TEST(SurveyHeuristics, MergeBranchingFactorIsAnOption) {
 TEST(SurveyHeuristics, CostIsIndependentOfInputOrder) {
     for (const Algorithm algorithm : order_independent_builders)
         for (const std::uint32_t count : {2u, 7u, 25u, 60u}) {
-            const std::vector<Primitive> primitives = scene(count, 77 + count, count % 2 == 1);
+            const std::vector<Primitive> primitives = generated_scene(count, 77 + count, count % 2 == 1);
             const double reference = cost_of(primitives, algorithm);
             for (std::uint64_t shuffle = 1; shuffle <= 4; ++shuffle) {
                 const double c = cost_of(shuffled(primitives, shuffle), algorithm);
@@ -140,7 +118,7 @@ TEST(SurveyHeuristics, CostIsIndependentOfInputOrder) {
 
 TEST(SurveyHeuristics, InsertionDependsOnInputOrder) {
     // The survey's complaint about insertion (§2.1): some shuffle of this scene changes the hierarchy.
-    const std::vector<Primitive> primitives = scene(30, 5);
+    const std::vector<Primitive> primitives = generated_scene(30, 5);
     for (const Algorithm algorithm : order_dependent_builders) {
         const double reference = cost_of(primitives, algorithm);
         bool changed = false;

@@ -15,16 +15,12 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/tree_properties.hpp"
 
 namespace hbvh {
 namespace {
 
-std::vector<Primitive> scene(std::uint32_t count, std::uint64_t seed) {
-    SceneOptions options;
-    options.count = count;
-    options.seed = seed;
-    return generate_scene(options);
-}
+using test_support::generated_scene;
 
 std::vector<std::pair<std::string, std::vector<Primitive>>> bundled_models() {
     std::vector<std::pair<std::string, std::vector<Primitive>>> models;
@@ -76,7 +72,7 @@ TEST(Treelet, NeverCostlierOnGeneratedScenes) {
     TreeletOptions options;
     options.max_units = 5;
     for (std::uint32_t count : {2u, 3u, 30u, 70u}) {
-        const std::vector<Primitive> primitives = scene(count, 7 + count);
+        const std::vector<Primitive> primitives = generated_scene(count, 7 + count);
         for (Algorithm algorithm : {Algorithm::split, Algorithm::insertion, Algorithm::scale}) {
             const Bvh input = build_with(primitives, algorithm);
             TreeletReport report;
@@ -88,7 +84,7 @@ TEST(Treelet, NeverCostlierOnGeneratedScenes) {
 }
 
 TEST(Treelet, RespectsThePolicy) {
-    const std::vector<Primitive> primitives = scene(20, 3);
+    const std::vector<Primitive> primitives = generated_scene(20, 3);
     VolumePolicy spheres_only = VolumePolicy::only(BvType::sphere);
     BuildOptions options;
     options.policy = spheres_only;
@@ -111,7 +107,7 @@ TEST(Treelet, OneTreeletOverEverythingIsOptimal) {
     TreeletOptions options;
     options.max_units = 8;
     for (std::uint32_t count : {3u, 5u, 8u}) {
-        const std::vector<Primitive> primitives = scene(count, 40 + count);
+        const std::vector<Primitive> primitives = generated_scene(count, 40 + count);
         const double optimum = cost(build_with(primitives, Algorithm::optimal));
         for (Algorithm algorithm : {Algorithm::two_level, Algorithm::split, Algorithm::insertion, Algorithm::merge}) {
             const Bvh refined = refine_treelets(build_with(primitives, algorithm), VolumePolicy::all(), options);
@@ -123,7 +119,7 @@ TEST(Treelet, OneTreeletOverEverythingIsOptimal) {
 }
 
 TEST(Treelet, SameTreeForAnyThreadCount) {
-    const std::vector<Primitive> primitives = scene(40, 11);
+    const std::vector<Primitive> primitives = generated_scene(40, 11);
     const Bvh input = build_with(primitives, Algorithm::split);
     auto refine_with = [&](int threads) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
@@ -142,7 +138,7 @@ TEST(Treelet, SameTreeForAnyThreadCount) {
 }
 
 TEST(Treelet, RefineOptionAppliesToAnyBuilder) {
-    const std::vector<Primitive> primitives = scene(25, 5);
+    const std::vector<Primitive> primitives = generated_scene(25, 5);
     BuildOptions options;
     BuildReport report;
     options.refine = true;
