@@ -314,8 +314,8 @@ Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& polic
         const std::size_t window_count = bounds.size() - 1;
 
         const std::uint32_t exact_limit = n0 <= options.exact_fit_all_up_to ? n0 : options.exact_fit_max_primitives;
-        LevelContext level{primitives, policy, options, exact_limit, n <= options.exact_fit_level_nodes,
-                           nodes, level_primitives, {}, false};
+        const bool refit_level = n <= options.exact_fit_level_nodes && n0 <= options.exact_fit_level_max_input;
+        LevelContext level{primitives, policy, options, exact_limit, refit_level, nodes, level_primitives, {}, false};
         if (options.time_limit_seconds > 0.0) {
             level.has_deadline = true;
             level.deadline = start + std::chrono::duration_cast<Clock::duration>(
