@@ -319,7 +319,8 @@ if wanted 1; then
         cheap=two-level,merge,insertion,insertion-haber,split,obbtree,scale,auto
         emit "Models of at most 30 primitives get every builder; larger ones only \`$cheap\`" \
              "(the survey's B&B builders, \`bnb-exact\` and \`optimal\` are exponential or need O(n³) fits and take" \
-             "minutes there). \`auto\` above 24 primitives is \`scale\`. A model that does not load is left out." ""
+             "minutes there). \`auto\` above 24 primitives keeps the cheapest of a portfolio led by \`scale\`" \
+             "(docs/scale.md §5). A model that does not load is left out." ""
         if ((${#small[@]} > 0)); then
             command_block "$hbvh compare ${small[*]} --markdown --repeat 3"
             "$hbvh" compare "${small[@]}" --markdown --repeat 3 >"$work/real_small.md"
@@ -356,7 +357,7 @@ if wanted 2; then
         --repeat 1 --markdown >"$work/scale.md"
     cat "$work/scale.md" >>"$doc"
     emit ""
-    emit "**What it shows.** One build each (\`--repeat 1\`); \`auto\` is \`scale\` at these sizes."
+    emit "**What it shows.** One build each (\`--repeat 1\`); \`auto\` keeps the cheaper of \`scale\` and \`split\` up to 20 000 primitives."
     summarise scale_summary "$work/scale.md"
     if [[ ${HBVH_RESULTS_1M:-0} == 1 ]]; then
         log "  10^6 bench (several minutes)"

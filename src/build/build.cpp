@@ -114,11 +114,20 @@ Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildOptions
     Algorithm winner = members.front();
     double best_cost = 0.0;
     std::string costs;
+    const bool limited = options.time_limit_seconds > 0.0;
+    std::string skipped;
     for (Algorithm member : members) {
+        // Under a time limit the members share it: each gets what is left, and once nothing is left the rest
+        // are skipped (the first always runs, so there is a tree). split and the insertions cannot stop early.
+        if (best && limited && elapsed() >= options.time_limit_seconds) {
+            skipped += (skipped.empty() ? "" : ", ") + std::string(to_string(member));
+            continue;
+        }
         BuildReport member_report;
         BuildOptions member_options = options;
         member_options.report = options.report != nullptr ? &member_report : nullptr;
         member_options.refine = false;
+        if (limited) member_options.time_limit_seconds = std::max(options.time_limit_seconds - elapsed(), 1e-9);
         Result<Bvh> built = build_one(primitives, member, member_options);
         if (!built) return built;
         Bvh tree = std::move(built.value());
@@ -150,6 +159,10 @@ Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildOptions
         else
             options.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
                                             std::string(to_string(winner)));
+        if (!skipped.empty()) {
+            options.report->notes.push_back("auto: time limit reached; skipped " + skipped);
+            options.report->budget_hit = true;
+        }
         if (refine_any) note_treelets(*options.report, best_treelets);
     }
     return std::move(*best);

@@ -2,11 +2,15 @@
 // Müller, Schäfer and Straßer's top-down splitting (survey §2.2): sort, sweep every cut point, recurse.
 #include "hbvh/build/top_down_split.hpp"
 
+#include <tbb/parallel_invoke.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <span>
+#include <vector>
 
 #include "heuristic_support.hpp"
 #include "hbvh/fit/fit.hpp"
@@ -85,25 +89,67 @@ private:
     double t_max_ = -std::numeric_limits<double>::infinity();
 };
 
+/// One node of the split tree before assembly: a leaf (one primitive) or an inner node with two children
+/// (indices into the same plan) and its BV.
+struct PlannedNode {
+    bool is_leaf = false;
+    std::uint32_t local = 0;  ///< Leaves: the primitive.
+    std::uint32_t left = 0;   ///< Inner nodes: children's plan indices.
+    std::uint32_t right = 0;
+    BoundingVolume volume;
+};
+
+/// Plans the tree top-down, the two halves of every cut in parallel (TBB), then hands it to the assembler
+/// in the order a serial recursion would. A node's plan slot is fixed by its range of the primitive order,
+/// not by which thread made it, and each range's sorting and fitting read only that range, so the tree is
+/// the same for any thread count.
 class Splitter {
 public:
-    Splitter(const PrimitiveSet& set, TreeAssembler& assembler, const SplitOptions& options)
-        : set_(set), assembler_(assembler), options_(options) {}
+    Splitter(const PrimitiveSet& set, const SplitOptions& options)
+        : set_(set), options_(options), order_(set.size()), plan_(2 * set.size() - 1) {
+        std::iota(order_.begin(), order_.end(), 0u);
+    }
 
-    // Builds the subtree over `locals` and returns its assembler id.
-    std::uint32_t build(std::vector<std::uint32_t> locals) {
-        if (locals.size() == 1) return assembler_.add_leaf(set_.input_index(locals.front()));
-        const BoundingVolume volume = set_.fit(locals);
-        const std::size_t cut = choose_cut(locals);  // locals is left sorted along the chosen axis
-        std::vector<std::uint32_t> right(locals.begin() + static_cast<std::ptrdiff_t>(cut), locals.end());
-        locals.resize(cut);
-        const std::uint32_t children[2] = {build(std::move(locals)), build(std::move(right))};
-        return assembler_.add_group(children, volume);
+    /// The hierarchy's root id in `assembler` after adding every node.
+    std::uint32_t build(TreeAssembler& assembler) {
+        const std::uint32_t root = plan(0, static_cast<std::uint32_t>(order_.size()));
+        return assemble(root, assembler);
     }
 
 private:
+    /// Slots: leaf of order position i at i; the inner node cutting its range before position c at n - 1 + c
+    /// (every gap between consecutive positions is cut by exactly one inner node).
+    std::uint32_t plan(std::uint32_t begin, std::uint32_t end) {
+        if (end - begin == 1) {
+            plan_[begin] = PlannedNode{true, order_[begin], 0, 0, {}};
+            return begin;
+        }
+        const std::span<std::uint32_t> locals(order_.data() + begin, end - begin);
+        BoundingVolume volume = set_.fit(locals);
+        const auto cut = begin + static_cast<std::uint32_t>(choose_cut(locals));  // sorts locals along the chosen axis
+        std::uint32_t left = 0;
+        std::uint32_t right = 0;
+        // Small ranges stay on this thread: a task costs more than they do.
+        constexpr std::uint32_t parallel_above = 256;
+        if (end - begin > parallel_above)
+            tbb::parallel_invoke([&] { left = plan(begin, cut); }, [&] { right = plan(cut, end); });
+        else
+            left = plan(begin, cut), right = plan(cut, end);
+        const auto slot = static_cast<std::uint32_t>(order_.size()) - 1 + cut;
+        plan_[slot] = PlannedNode{false, 0, left, right, std::move(volume)};
+        return slot;
+    }
+
+    /// Left subtree, right subtree, then the node: the order of the former serial recursion.
+    std::uint32_t assemble(std::uint32_t slot, TreeAssembler& assembler) const {
+        const PlannedNode& node = plan_[slot];
+        if (node.is_leaf) return assembler.add_leaf(set_.input_index(node.local));
+        const std::uint32_t children[2] = {assemble(node.left, assembler), assemble(node.right, assembler)};
+        return assembler.add_group(children, node.volume);
+    }
+
     // Sorts `locals` along the best axis and returns the size of the left part (1..size-1).
-    std::size_t choose_cut(std::vector<std::uint32_t>& locals) {
+    std::size_t choose_cut(std::span<std::uint32_t> locals) const {
         const std::size_t count = locals.size();
         const bool per_side = count <= options_.per_side_pricing_limit;
         Obb frame;
@@ -138,7 +184,7 @@ private:
     }
 
     // Centre along `axis`; equal centres fall back to the canonical index, itself an order on geometry.
-    void sort_along(std::vector<std::uint32_t>& locals, int axis) const {
+    void sort_along(std::span<std::uint32_t> locals, int axis) const {
         std::sort(locals.begin(), locals.end(), [&](std::uint32_t a, std::uint32_t b) {
             const double ca = set_.centre(a)[axis], cb = set_.centre(b)[axis];
             return ca != cb ? ca < cb : a < b;
@@ -146,13 +192,13 @@ private:
     }
 
     // prefix[i]: weighted volume around locals[0..i]; suffix[i]: around locals[i..end).
-    void side_volumes(const std::vector<std::uint32_t>& locals, bool per_side, const Obb& frame,
+    void side_volumes(std::span<const std::uint32_t> locals, bool per_side, const Obb& frame,
                       std::vector<double>& prefix, std::vector<double>& suffix) const {
         const std::size_t count = locals.size();
         if (per_side) {
             for (std::size_t i = 0; i < count; ++i) {
-                prefix[i] = set_.estimate(std::span(locals).first(i + 1));
-                suffix[i] = set_.estimate(std::span(locals).subspan(i));
+                prefix[i] = set_.estimate(locals.first(i + 1));
+                suffix[i] = set_.estimate(locals.subspan(i));
             }
             return;
         }
@@ -166,8 +212,9 @@ private:
     }
 
     const PrimitiveSet& set_;
-    TreeAssembler& assembler_;
     const SplitOptions& options_;
+    std::vector<std::uint32_t> order_;  ///< Local primitive indices; each plan() call sorts only its range.
+    std::vector<PlannedNode> plan_;     ///< n leaves, then n - 1 inner nodes by their cut position.
 };
 
 }  // namespace
@@ -177,9 +224,7 @@ Result<Bvh> build_top_down_split(std::span<const Primitive> primitives, const Vo
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
     const PrimitiveSet set(primitives, detail::canonical_order(primitives), policy);
     TreeAssembler assembler(primitives);
-    std::vector<std::uint32_t> all(set.size());
-    std::iota(all.begin(), all.end(), 0u);
-    const std::uint32_t root = Splitter(set, assembler, options).build(std::move(all));
+    const std::uint32_t root = Splitter(set, options).build(assembler);
     return std::move(assembler).finish(root);
 }
 

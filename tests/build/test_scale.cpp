@@ -18,6 +18,7 @@
 namespace hbvh {
 namespace {
 
+using test_support::expect_identical_trees;
 using test_support::expect_tree_properties;
 using test_support::generated_scene;
 
@@ -57,25 +58,7 @@ TEST(Scale, SameHierarchyForOneAndTwoThreads) {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
         return build_scale(primitives, VolumePolicy::all());
     };
-    const Bvh one = build_with(1);
-    const Bvh two = build_with(2);
-    EXPECT_EQ(cost(one), cost(two));
-    ASSERT_EQ(one.nodes.size(), two.nodes.size());
-    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
-        const Node& a = one.nodes[i];
-        const Node& b = two.nodes[i];
-        ASSERT_EQ(a.child_count, b.child_count) << "node " << i;
-        ASSERT_EQ(a.first_child, b.first_child) << "node " << i;
-        ASSERT_EQ(a.primitive, b.primitive) << "node " << i;
-        ASSERT_EQ(a.volume.index(), b.volume.index()) << "node " << i;
-        // Bit-identical BVs: same fitter, same inputs in the same order.
-        ASSERT_EQ(generating_spheres(a.volume).size(), generating_spheres(b.volume).size());
-        const auto sa = generating_spheres(a.volume), sb = generating_spheres(b.volume);
-        for (std::size_t k = 0; k < sa.size(); ++k) {
-            ASSERT_EQ(sa[k].center, sb[k].center) << "node " << i;
-            ASSERT_EQ(sa[k].radius, sb[k].radius) << "node " << i;
-        }
-    }
+    expect_identical_trees(build_with(1), build_with(2));
 }
 
 // merge is beaten on every scene. split is not: its top-down cuts give 30-40 % lower Eq. 2 costs than
@@ -136,6 +119,25 @@ TEST(Auto, PicksBySizeAndSaysSo) {
         });
         EXPECT_NE(said, report.notes.end()) << (report.notes.empty() ? "" : report.notes.front());
     }
+}
+
+// Under a time limit the portfolio's members share it: once it is used up the rest are skipped, and the
+// report says so. The first member always runs, so there is a valid tree.
+TEST(Auto, TimeLimitSkipsTheRestOfThePortfolio) {
+    const std::vector<Primitive> primitives = generated_scene(auto_insertion_max_primitives + 50, 17);
+    ASSERT_EQ(auto_portfolio(primitives.size()), (std::vector<Algorithm>{Algorithm::scale, Algorithm::split}));
+    BuildReport report;
+    BuildOptions options;
+    options.report = &report;
+    options.time_limit_seconds = 1e-6;
+    Result<Bvh> built = build(primitives, Algorithm::automatic, options);
+    ASSERT_TRUE(built.has_value());
+    expect_tree_properties(primitives, built.value());
+    EXPECT_TRUE(report.budget_hit);
+    const auto said = std::find_if(report.notes.begin(), report.notes.end(), [](const std::string& note) {
+        return note == "auto: time limit reached; skipped split";
+    });
+    EXPECT_NE(said, report.notes.end());
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // The survey's heuristic builders (§2.1-2.3) through build(): shared properties, order (in)dependence.
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -37,6 +38,7 @@ Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorit
     return bvh;
 }
 
+using test_support::expect_identical_trees;
 using test_support::generated_scene;
 
 std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
@@ -114,6 +116,18 @@ TEST(SurveyHeuristics, CostIsIndependentOfInputOrder) {
                     << to_string(algorithm) << ", " << count << " primitives, shuffle " << shuffle;
             }
         }
+}
+
+// split plans the two halves of every cut in parallel; the tree must not depend on the thread count.
+TEST(SurveyHeuristics, SplitSameTreeForOneAndTwoThreads) {
+    const std::vector<Primitive> primitives = generated_scene(3000, 43);
+    const auto build_with = [&](std::size_t threads) {
+        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+        Result<Bvh> built = build(primitives, Algorithm::split);
+        EXPECT_TRUE(built.has_value());
+        return built.has_value() ? std::move(built.value()) : Bvh{};
+    };
+    expect_identical_trees(build_with(1), build_with(2));
 }
 
 TEST(SurveyHeuristics, InsertionDependsOnInputOrder) {

@@ -47,4 +47,24 @@ inline void expect_tree_properties(const std::vector<Primitive>& primitives, con
     EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
 }
 
+/// The same tree node by node: structure, primitives, BV kinds and bit-identical BVs (what "deterministic for
+/// any thread count" promises).
+inline void expect_identical_trees(const Bvh& one, const Bvh& two) {
+    ASSERT_EQ(one.nodes.size(), two.nodes.size());
+    for (std::size_t i = 0; i < one.nodes.size(); ++i) {
+        const Node& a = one.nodes[i];
+        const Node& b = two.nodes[i];
+        ASSERT_EQ(a.child_count, b.child_count) << "node " << i;
+        ASSERT_EQ(a.first_child, b.first_child) << "node " << i;
+        ASSERT_EQ(a.primitive, b.primitive) << "node " << i;
+        ASSERT_EQ(a.volume.index(), b.volume.index()) << "node " << i;
+        const auto sa = generating_spheres(a.volume), sb = generating_spheres(b.volume);
+        ASSERT_EQ(sa.size(), sb.size()) << "node " << i;
+        for (std::size_t k = 0; k < sa.size(); ++k) {
+            ASSERT_EQ(sa[k].center, sb[k].center) << "node " << i;
+            ASSERT_EQ(sa[k].radius, sb[k].radius) << "node " << i;
+        }
+    }
+}
+
 }  // namespace hbvh::test_support
