@@ -36,7 +36,7 @@ Projected project(std::span<const Sphere> spheres, const Mat3& frame) {
 }
 
 /// Per-sphere numbers the radius search reads: axial coordinate, own radius and squared distance from the
-/// axis line, as separate arrays so that the loop below vectorises (it runs ~30 times per direction).
+/// axis line, computed once per direction as plain arrays (the search reads them ~30 times per direction).
 struct AxisDistances {
     std::vector<double> axial;
     std::vector<double> radius;
