@@ -78,6 +78,10 @@ hbvh_cli_rejects(tiny.xml "tiny.xml: .*volumes underflow double precision")
 
 # Usage errors: exit 2 (bad arguments) or 1 (bad input file).
 hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-not-exist.xml -o ${HBVH_CLI_OUT}/x.xml)
+# A directory whose name looks like a model is refused as a directory, not by its extension.
+file(MAKE_DIRECTORY ${HBVH_CLI_OUT}/a_directory.xml)
+hbvh_cli_test(directory_input 1 "a_directory.xml: is a directory, not a file" build ${HBVH_CLI_OUT}/a_directory.xml
+              -o ${HBVH_CLI_OUT}/directory.out.xml)
 hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -a no-such-builder -o ${HBVH_CLI_OUT}/x.xml)
 

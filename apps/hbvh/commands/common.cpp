@@ -18,6 +18,9 @@ namespace hbvh::cli {
 namespace {
 /// The file as a Model, without checks across primitives (load_model adds those).
 Result<Model> read_model(const std::string& path, const std::string& format) {
+    // Before any guess from the extension: a directory named "scene.xml" or "tmp.x1y2" is still a directory.
+    std::error_code ignored;
+    if (path != "-" && std::filesystem::is_directory(path, ignored)) return Error{"is a directory, not a file", path};
     // A plain mesh (no UBX_/USP_/UCP_/UCX_ pieces) is imported only on request: one fitted primitive per
     // mesh node is a guess at the author's intent, not a reading of it.
     if (format == "mesh-nodes") {
