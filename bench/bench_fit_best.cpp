@@ -77,7 +77,7 @@ void register_fit_small_benchmarks() {
             ->Unit(benchmark::kMicrosecond);
 }
 
-const bool registered = (register_fit_small_benchmarks(), true);
+const bool fit_small_benchmarks_registered = (register_fit_small_benchmarks(), true);
 
 }  // namespace
 }  // namespace hbvh

@@ -107,7 +107,7 @@ void register_all() {
 }
 
 /// Registers at static-initialisation time, before BENCHMARK_MAIN parses the command line.
-const bool registered = (register_all(), true);
+const bool query_benchmarks_registered = (register_all(), true);
 
 }  // namespace
 }  // namespace hbvh

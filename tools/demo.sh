@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/install-deps.sh
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DHBVH_UNITY_BUILD=ON >/dev/null
 cmake --build build
 model=${1:-data/models/tie_interceptor.xml}
 out=build/demo/$(basename "${model%.xml}").hbvh.xml

@@ -29,7 +29,7 @@
 namespace hbvh {
 namespace {
 
-constexpr double infinity = std::numeric_limits<double>::infinity();
+constexpr double infinite_cost = std::numeric_limits<double>::infinity();
 
 /// The tables of the DP.
 struct Tables {
@@ -47,7 +47,7 @@ Tables run_dp(std::uint32_t count, std::span<const double> volume) {
     t.count = count;
     const std::uint32_t subsets = 1u << count;
     t.best.assign(subsets, 0.0);
-    t.parts.assign(std::size_t{subsets} * count, infinity);
+    t.parts.assign(std::size_t{subsets} * count, infinite_cost);
     t.children.assign(subsets, 0);
     for (std::uint32_t s = 1; s < subsets; ++s) {
         double* row = t.row(s);
@@ -70,7 +70,7 @@ Tables run_dp(std::uint32_t count, std::span<const double> volume) {
         }
         // best(S) = min over k >= 2 of k·vol(S) + P_k(S); the first (smallest) k wins ties.
         const double w = volume[s];
-        double best = infinity;
+        double best = infinite_cost;
         std::uint8_t arg = 0;
         for (std::uint32_t k = 2; k <= size; ++k) {
             const double candidate = static_cast<double>(k) * w + row[k - 1];

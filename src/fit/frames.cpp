@@ -10,6 +10,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "hull_2d.hpp"
+#include "rounding_pad.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -41,10 +42,6 @@ double squared_distance_to_line(const Vec3& p, const Vec3& a, const Vec3& u) {
     const Vec3 d = p - a;
     return (d - d.dot(u) * u).squaredNorm();
 }
-
-/// A tiny relative pad (about 4 ulps of `magnitude`) that keeps containment true even when a
-/// caller's re-evaluation rounds differently (e.g. with fused multiply-add contraction).
-double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
 
 }  // namespace
 

@@ -11,6 +11,7 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "min_circle.hpp"
+#include "rounding_pad.hpp"
 
 namespace hbvh {
 namespace {
@@ -21,10 +22,6 @@ namespace {
 using Kernel = CGAL::Simple_cartesian<double>;
 using Traits3 = CGAL::Min_sphere_of_spheres_d_traits_3<Kernel, double>;
 using Traits2 = CGAL::Min_sphere_of_spheres_d_traits_2<Kernel, double>;
-
-/// A few ulps of `magnitude`: CGAL's centre is rounded, and callers may re-evaluate containment
-/// with different rounding (fused multiply-add), so a radius that is merely tight could miss by an ulp.
-double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
 
 }  // namespace
 
@@ -43,7 +40,7 @@ Sphere fit_sphere(std::span<const Sphere> spheres) {
     // CGAL's answer is optimal up to rounding; measure containment the way Sphere::contains does and grow.
     for (const Sphere& s : spheres) result.radius = std::max(result.radius, (s.center - result.center).norm() + s.radius);
     // The distances are of nearby points, so their rounding scales with the radius, not the coordinates.
-    result.radius += rounding_pad(result.radius);
+    result.radius += detail::rounding_pad(result.radius);
     return result;
 }
 

@@ -8,20 +8,16 @@
 
 #include "hbvh/build/bottom_up.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
 
+using test_support::make_level;
+
 Primitive cube_at(double x) { return {Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, ""}; }
 
 /// A level over `primitives`, one node each, in the given order (already canonical for these tests).
-Level make_level(const std::vector<Primitive>& primitives, const VolumePolicy& policy) {
-    std::vector<LevelNode> nodes;
-    for (std::uint32_t p = 0; p < primitives.size(); ++p)
-        nodes.push_back({primitives[p].volume, policy.weighted_volume(primitives[p].volume), {p}});
-    return Level(primitives, std::move(nodes), policy);
-}
-
 TEST(Level, FitsGroupsAroundPrimitivesOnceAndMeasuresEq1) {
     const std::vector<Primitive> primitives{cube_at(0), cube_at(2), cube_at(4)};
     const Level level = make_level(primitives, VolumePolicy::only(BvType::aabb));

@@ -18,9 +18,12 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
+
+using test_support::shuffled;
 
 constexpr Algorithm bnb_algorithms[] = {Algorithm::bnb_tightest, Algorithm::bnb_enlarge};
 
@@ -30,12 +33,6 @@ BuildOptions test_options(BuildReport* report) {
     options.report = report;
     options.branch_and_bound.budget.max_nodes = 200'000;
     return options;
-}
-
-std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
-    SplitMix64 rng(seed);
-    for (std::size_t i = primitives.size(); i > 1; --i) std::swap(primitives[i - 1], primitives[rng.below(i)]);
-    return primitives;
 }
 
 /// The checks every hierarchy must pass, with messages naming the scene.

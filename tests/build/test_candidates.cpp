@@ -9,16 +9,12 @@
 #include <vector>
 
 #include "hbvh/build/candidates.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
 
-Level make_level(const std::vector<Primitive>& primitives, const VolumePolicy& policy) {
-    std::vector<LevelNode> nodes;
-    for (std::uint32_t p = 0; p < primitives.size(); ++p)
-        nodes.push_back({primitives[p].volume, policy.weighted_volume(primitives[p].volume), {p}});
-    return Level(primitives, std::move(nodes), policy);
-}
+using test_support::make_level;
 
 std::set<std::vector<std::uint32_t>> normalised(std::vector<std::vector<std::uint32_t>> sets) {
     std::set<std::vector<std::uint32_t>> out;

@@ -18,7 +18,7 @@ namespace hbvh {
 namespace {
 
 /// Cheapest exact cover by trying every subset of candidates (only for a handful of candidates).
-std::optional<double> exhaustive_optimum(std::uint32_t node_count, const std::vector<Candidate>& candidates) {
+std::optional<double> cheapest_cover_by_enumeration(std::uint32_t node_count, const std::vector<Candidate>& candidates) {
     std::optional<double> best;
     const std::uint32_t subsets = 1u << candidates.size();
     std::vector<int> hits(node_count);
@@ -55,7 +55,7 @@ struct Instance {
     std::vector<Candidate> candidates;
     std::vector<double> volumes;
 };
-Instance random_instance(SplitMix64& rng, bool admissible) {
+Instance random_reference_instance(SplitMix64& rng, bool admissible) {
     Instance instance;
     instance.node_count = 1 + static_cast<std::uint32_t>(rng.below(8));
     for (std::uint32_t j = 0; j < instance.node_count; ++j) instance.volumes.push_back(rng.uniform(0.1, 3.0));
@@ -95,8 +95,8 @@ TEST(ReferenceBranchAndBound, MatchesExhaustiveSearchWhenEq7Holds) {
     SplitMix64 rng(2024);
     int with_cover = 0;
     for (int trial = 0; trial < 4000; ++trial) {
-        const Instance instance = random_instance(rng, true);
-        const std::optional<double> expected = exhaustive_optimum(instance.node_count, instance.candidates);
+        const Instance instance = random_reference_instance(rng, true);
+        const std::optional<double> expected = cheapest_cover_by_enumeration(instance.node_count, instance.candidates);
         const std::optional<Partition> found =
             solve_reference_branch_and_bound(instance.node_count, instance.candidates, instance.volumes);
         ASSERT_EQ(expected.has_value(), found.has_value()) << "trial " << trial;
@@ -116,8 +116,8 @@ TEST(ReferenceBranchAndBound, NeverBetterThanExhaustiveAndFindsACoverWheneverOne
     // solution first, so it still finds some cover exactly when one exists.
     SplitMix64 rng(77);
     for (int trial = 0; trial < 3000; ++trial) {
-        const Instance instance = random_instance(rng, false);
-        const std::optional<double> expected = exhaustive_optimum(instance.node_count, instance.candidates);
+        const Instance instance = random_reference_instance(rng, false);
+        const std::optional<double> expected = cheapest_cover_by_enumeration(instance.node_count, instance.candidates);
         const std::optional<Partition> found =
             solve_reference_branch_and_bound(instance.node_count, instance.candidates, instance.volumes);
         ASSERT_EQ(expected.has_value(), found.has_value()) << "trial " << trial;
@@ -167,7 +167,7 @@ TEST(ReferenceBranchAndBound, Eq7PrunesTheOptimumWhenChildrenOverlap) {
     ASSERT_TRUE(found.has_value());
     EXPECT_DOUBLE_EQ(found->cost, 6.0);  // the whole level, found first; the root bound 2 x 4 = 8 > 6 prunes the rest
     EXPECT_EQ(found->chosen, (std::vector<std::uint32_t>{2}));
-    EXPECT_DOUBLE_EQ(*exhaustive_optimum(4, candidates), 4.0);  // the two pairs
+    EXPECT_DOUBLE_EQ(*cheapest_cover_by_enumeration(4, candidates), 4.0);  // the two pairs
     EXPECT_LT(found->lower_bound, found->cost);                  // not claimed optimal
     EXPECT_LE(found->lower_bound, 4.0);
 }

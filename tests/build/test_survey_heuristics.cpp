@@ -14,6 +14,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/test_helpers.hpp"
 #include "support/tree_properties.hpp"
 
 
@@ -40,12 +41,7 @@ Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorit
 
 using test_support::expect_identical_trees;
 using test_support::generated_scene;
-
-std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
-    SplitMix64 random(seed);
-    for (std::size_t i = primitives.size(); i > 1; --i) std::swap(primitives[i - 1], primitives[random.below(i)]);
-    return primitives;
-}
+using test_support::shuffled;
 
 double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm) {
     Result<Bvh> built = build(primitives, algorithm);

@@ -9,14 +9,12 @@
 #include "../../src/fit/capsule_bound.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/scene/generate.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
 
-Vec3 random_vector(SplitMix64& rng, double half_width) {
-    return {rng.uniform(-half_width, half_width), rng.uniform(-half_width, half_width),
-            rng.uniform(-half_width, half_width)};
-}
+using test_support::random_vector;
 
 /// Spheres inside a random capsule, plus its two end spheres: the fitter then finds that capsule (or a
 /// smaller one), so the bound is checked where it is closest to the truth.

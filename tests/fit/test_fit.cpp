@@ -16,9 +16,12 @@
 
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/scene/generate.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
+
+using test_support::random_vector;
 
 /// One named test input: spheres and the hint axes a builder would pass with them.
 struct SphereSet {
@@ -31,11 +34,6 @@ struct SphereSet {
 double set_size(std::span<const Sphere> spheres) {
     const Aabb box = fit_aabb(spheres);
     return std::max(0.5 * (box.max - box.min).norm(), 1e-300);
-}
-
-Vec3 random_vector(SplitMix64& rng, double half_width) {
-    return {rng.uniform(-half_width, half_width), rng.uniform(-half_width, half_width),
-            rng.uniform(-half_width, half_width)};
 }
 
 std::vector<Sphere> corners_of(const Obb& box) {

@@ -1,0 +1,12 @@
+// SPDX-License-Identifier: MIT
+// Internal: the pad the fitters add to a computed size so that containment survives re-evaluation.
+#pragma once
+
+namespace hbvh::detail {
+
+/// A tiny relative pad (about 4 ulps of `magnitude`). Fitted centres and extents are rounded, and callers
+/// may re-evaluate containment with different rounding (fused multiply-add contraction), so a size that is
+/// merely tight could miss a generating sphere by an ulp.
+inline double rounding_pad(double magnitude) { return magnitude * 0x1.0p-50; }
+
+}  // namespace hbvh::detail

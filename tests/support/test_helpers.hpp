@@ -1,0 +1,36 @@
+// SPDX-License-Identifier: MIT
+// Small helpers more than one test file needs: random vectors from the seeded generator, and a bottom-up
+// level over primitives as they are (one node per primitive).
+#pragma once
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "hbvh/build/bottom_up.hpp"
+#include "hbvh/scene/generate.hpp"
+
+namespace hbvh::test_support {
+
+/// A vector with each coordinate uniform in [-half_width, half_width].
+inline Vec3 random_vector(SplitMix64& rng, double half_width) {
+    return {rng.uniform(-half_width, half_width), rng.uniform(-half_width, half_width),
+            rng.uniform(-half_width, half_width)};
+}
+
+/// `primitives` in a seeded random order (Fisher-Yates).
+inline std::vector<Primitive> shuffled(std::vector<Primitive> primitives, std::uint64_t seed) {
+    SplitMix64 rng(seed);
+    for (std::size_t i = primitives.size(); i > 1; --i) std::swap(primitives[i - 1], primitives[rng.below(i)]);
+    return primitives;
+}
+
+/// The first level of a bottom-up build: one node per primitive, in input order.
+inline Level make_level(const std::vector<Primitive>& primitives, const VolumePolicy& policy) {
+    std::vector<LevelNode> nodes;
+    for (std::uint32_t p = 0; p < primitives.size(); ++p)
+        nodes.push_back({primitives[p].volume, policy.weighted_volume(primitives[p].volume), {p}});
+    return Level(primitives, std::move(nodes), policy);
+}
+
+}  // namespace hbvh::test_support
