@@ -3,6 +3,7 @@
 #include "hbvh/io/mesh_import.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
@@ -95,9 +96,14 @@ bool has_positive_size(const BoundingVolume& volume) {
 // the file can hold is refused before assimp sees it, as is a header without end_header.
 Status check_ply_header(const std::string& path) {
     std::ifstream stream(path, std::ios::binary);
-    // assimp takes any file starting with these three letters as PLY, whatever follows them on the line.
+    // assimp takes any file starting with these three letters as PLY, in any case and after leading line breaks
+    // ("plY" and "\nply" too, both found by fuzzing), whatever follows them on the line. Leading whitespace of
+    // any kind is skipped here: checking a file assimp would refuse anyway costs nothing.
+    stream >> std::ws;
     char magic[3] = {};
-    if (!stream.read(magic, 3) || std::string_view(magic, 3) != "ply") return Ok{};
+    if (!stream.read(magic, 3)) return Ok{};
+    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (std::string_view(magic, 3) != "ply") return Ok{};
     stream.seekg(0, std::ios::end);
     const auto file_size = static_cast<std::uint64_t>(stream.tellg());
     stream.seekg(0);

@@ -104,6 +104,20 @@ TEST(ImportRegressions, PlyWithGarbageAfterTheMagicIsChecked) {
     EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
 }
 
+// assimp 5.2 also takes "plY" and a magic after leading line breaks as PLY, and hung on such files without
+// end_header (found by fuzz_ply): the header check now matches the magic as loosely.
+TEST(ImportRegressions, PlyMagicInAnyCaseOrAfterLineBreaksIsChecked) {
+    const ScratchFolder folder("ply_loose_magic");
+    for (const std::string prefix : {"plY", "PLY", "\nply", "\r\n\nply", "\tply"}) {
+        SCOPED_TRACE(prefix);
+        const std::string path = folder.write(
+            "open.ply", prefix + "\nformat binary_little_endply\nformat ascii 1.0\nelement vertex 4\npria");
+        const Result<ImportResult> imported = import_mesh(path);
+        ASSERT_FALSE(imported.has_value());
+        EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+    }
+}
+
 // Coincident, collinear or coplanar collision pieces fitted zero-size volumes (a radius-0 sphere, a box of height
 // 0), which `hbvh convert` wrote and every XML reader of hbvh then refused.
 TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
