@@ -3,20 +3,17 @@
 #include "hbvh/io/mesh_import.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <limits>
 #include <regex>
-#include <sstream>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
 #include "hbvh/fit/fit.hpp"
+#include "ply_header.hpp"
 
 namespace hbvh {
 namespace {
@@ -90,73 +87,12 @@ bool has_positive_size(const BoundingVolume& volume) {
     return (box.max.array() > box.min.array()).all();
 }
 
-// assimp's PLY reader (5.2) hangs on a header without end_header, and trusts the header's element counts:
-// "element vertex 99999999999" in an 80-byte file makes it loop and allocate for minutes. Every element instance takes at least one byte per property (one
-// byte for a property-less element), in ASCII and binary alike, so a header that declares more than the rest of
-// the file can hold is refused before assimp sees it, as is a header without end_header.
-Status check_ply_header(const std::string& path) {
-    std::ifstream stream(path, std::ios::binary);
-    // assimp takes any file starting with these three letters as PLY, in any case and after leading line breaks
-    // ("plY" and "\nply" too, both found by fuzzing), whatever follows them on the line. Leading whitespace of
-    // any kind is skipped here: checking a file assimp would refuse anyway costs nothing.
-    stream >> std::ws;
-    char magic[3] = {};
-    if (!stream.read(magic, 3)) return Ok{};
-    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (std::string_view(magic, 3) != "ply") return Ok{};
-    stream.seekg(0, std::ios::end);
-    const auto file_size = static_cast<std::uint64_t>(stream.tellg());
-    stream.seekg(0);
-    constexpr std::uint64_t saturated = std::numeric_limits<std::uint64_t>::max() / 2;
-    std::uint64_t needed = 0;           // Bytes the declared elements take at least.
-    std::uint64_t element_count = 0;    // Instances of the element being declared.
-    std::uint64_t property_count = 0;   // Its properties so far.
-    auto close_element = [&] {
-        const std::uint64_t per_instance = std::max<std::uint64_t>(1, property_count);
-        needed = element_count > (saturated - needed) / per_instance ? saturated : needed + element_count * per_instance;
-    };
-    std::string line;
-    int line_number = 0;
-    while (std::getline(stream, line)) {
-        ++line_number;
-        std::istringstream words(line);
-        std::string keyword;
-        words >> keyword;
-        if (keyword == "element") {
-            close_element();
-            std::string name, count;
-            words >> name >> count;
-            // Saturate instead of failing on overlong numbers: assimp reads them too, and the size check below
-            // then refuses the file.
-            element_count = 0;
-            for (const char digit : count) {
-                if (digit < '0' || digit > '9') break;
-                element_count = std::min(saturated, element_count * 10 + static_cast<std::uint64_t>(digit - '0'));
-            }
-            property_count = 0;
-        } else if (keyword == "property") {
-            ++property_count;
-        } else if (keyword == "end_header") {
-            close_element();
-            const auto header_end = static_cast<std::uint64_t>(stream.tellg());
-            const std::uint64_t body = stream.eof() || header_end > file_size ? 0 : file_size - header_end;
-            if (needed > body)
-                return Error("PLY header declares elements needing at least " + std::to_string(needed) +
-                                 " bytes, but only " + std::to_string(body) + " follow the header",
-                             path, line_number);
-            return Ok{};
-        }
-    }
-    // assimp 5.2 never stops looking for the end of such a header.
-    return Error("PLY header has no end_header line", path, line_number);
-}
-
 }  // namespace
 
 Result<ImportResult> import_mesh(const std::string& path, const MeshImportOptions& options) {
     // Only positions are needed: no normals, no triangulation. Assimp has no logger unless one is created, so it
     // stays silent.
-    if (Status header = check_ply_header(path); !header) return header.error();
+    if (Status header = detail::check_ply_header(path); !header) return header.error();
     Assimp::Importer importer;
     const aiScene* scene = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     if (scene == nullptr || scene->mRootNode == nullptr) {

@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
@@ -86,7 +88,7 @@ TEST(ImportRegressions, PlyHeaderWithoutEndIsRefused) {
                                                       "0 1 0\n0 0 1 z\nelement face 4\nprope3\n3 1 2 3\n");
     const Result<ImportResult> imported = import_mesh(path);
     ASSERT_FALSE(imported.has_value());
-    EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+    EXPECT_NE(imported.error().message.find("PLY header"), std::string::npos) << imported.error().message;
 }
 
 // A binary PLY whose magic line is "ply" plus garbage and whose header never ends: assimp 5.2 read out of bounds
@@ -101,11 +103,11 @@ TEST(ImportRegressions, PlyWithGarbageAfterTheMagicIsChecked) {
         232);
     const Result<ImportResult> imported = import_mesh(folder.write("crash.ply", bytes));
     ASSERT_FALSE(imported.has_value());
-    EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+    EXPECT_NE(imported.error().message.find("PLY header"), std::string::npos) << imported.error().message;
 }
 
 // assimp 5.2 also takes "plY" and a magic after leading line breaks as PLY, and hung on such files without
-// end_header (found by fuzz_ply): the header check now matches the magic as loosely.
+// end_header (found by fuzz_ply): the header check matches the magic as loosely, then wants a proper "ply" line.
 TEST(ImportRegressions, PlyMagicInAnyCaseOrAfterLineBreaksIsChecked) {
     const ScratchFolder folder("ply_loose_magic");
     for (const std::string prefix : {"plY", "PLY", "\nply", "\r\n\nply", "\tply"}) {
@@ -114,8 +116,43 @@ TEST(ImportRegressions, PlyMagicInAnyCaseOrAfterLineBreaksIsChecked) {
             "open.ply", prefix + "\nformat binary_little_endply\nformat ascii 1.0\nelement vertex 4\npria");
         const Result<ImportResult> imported = import_mesh(path);
         ASSERT_FALSE(imported.has_value());
-        EXPECT_NE(imported.error().message.find("no end_header"), std::string::npos) << imported.error().message;
+        EXPECT_EQ(imported.error().line, 1);
+        EXPECT_NE(imported.error().message.find("first line must be exactly \"ply\""), std::string::npos)
+            << imported.error().message;
     }
+}
+
+// The header's grammar is checked line by line, so that assimp only ever sees a well-formed header: a vertical
+// tab after end_header hung it (fuzz_ply), and unknown keywords or malformed lines are refused with the line.
+TEST(ImportRegressions, PlyHeaderGrammarIsChecked) {
+    const ScratchFolder folder("ply_grammar");
+    const std::string start = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\n";
+    const std::pair<std::string, std::string> cases[] = {
+        {start + "end_header\v0 0 0\n", "a control or non-ASCII byte outside a comment"},
+        {start + "end_header 0 0 0\n", "end_header must stand alone"},
+        {start + "elemfo float y\nend_header\n0\n", "unknown keyword \"elemfo\""},
+        {start + "property floot y\nend_header\n0 0\n", "expected \"property TYPE NAME\""},
+        {start + "element face -1\nend_header\n0\n", "expected \"element NAME COUNT\""},
+        {"ply\nproperty float x\nend_header\n0\n", "the second line must be"},
+        {"ply\nformat ascii 1.0\nproperty float x\nend_header\n0\n", "a property before any element"},
+    };
+    for (const auto& [text, problem] : cases) {
+        SCOPED_TRACE(text);
+        const Result<ImportResult> imported = import_mesh(folder.write("bad.ply", text));
+        ASSERT_FALSE(imported.has_value());
+        EXPECT_NE(imported.error().message.find(problem), std::string::npos) << imported.error().message;
+        EXPECT_GT(imported.error().line, 0);
+    }
+    // What real writers put in a header still passes: comments with any bytes, obj_info, CRLF line ends, lists.
+    const std::string good = "ply\r\nformat ascii 1.0\r\ncomment \xc3\xa9t\xc3\xa9 \x01\r\nobj_info made by hand\r\n"
+                             "element vertex 4\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\n"
+                             "element face 1\r\nproperty list uchar int vertex_indices\r\nend_header\r\n"
+                             "0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n4 0 1 2 3\r\n";
+    MeshImportOptions per_mesh;
+    per_mesh.one_primitive_per_mesh = true;
+    const Result<ImportResult> imported = import_mesh(folder.write("good.ply", good), per_mesh);
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    EXPECT_EQ(imported->primitives.size(), 1u);
 }
 
 // Coincident, collinear or coplanar collision pieces fitted zero-size volumes (a radius-0 sphere, a box of height
