@@ -6,9 +6,10 @@
 #include <array>
 #include <cctype>
 #include <cstdint>
+#include <filesystem>
 #include <fstream>
+#include <istream>
 #include <limits>
-#include <sstream>
 #include <string_view>
 #include <vector>
 
@@ -57,17 +58,31 @@ bool parse_count(std::string_view text, std::uint64_t saturated, std::uint64_t& 
     return true;
 }
 
+bool is_named_ply(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return extension == ".ply";
+}
+
+/// True when the first bytes that are neither whitespace nor control characters spell "ply" in any case.
+bool starts_like_ply(std::istream& stream) {
+    char c = 0;
+    while (stream.get(c) && (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f)) {
+    }
+    std::string magic(1, c);
+    for (int i = 0; i < 2 && stream.get(c); ++i) magic += c;
+    for (char& m : magic) m = static_cast<char>(std::tolower(static_cast<unsigned char>(m)));
+    return magic == "ply";
+}
+
 }  // namespace
 
 Status check_ply_header(const std::string& path) {
     std::ifstream stream(path, std::ios::binary);
-    // assimp takes a file as PLY when its first word is "ply" in any case, even after leading line breaks ("plY"
-    // and "\nply" both hung it, found by fuzzing). Such a file must then be proper PLY, which starts "ply".
-    stream >> std::ws;
-    char magic[3] = {};
-    if (!stream.read(magic, 3)) return Ok{};
-    for (char& c : magic) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    if (std::string_view(magic, 3) != "ply") return Ok{};
+    // assimp reads a file as PLY when it is named .ply, and otherwise when it starts with "ply" in any case, even
+    // after leading control bytes ("plY", "\nply" and "\0\0\0\5\nply" all hung it, found by fuzzing). Every such
+    // file must be proper PLY, whose first line is "ply".
+    if (!is_named_ply(path) && !starts_like_ply(stream)) return Ok{};
     stream.clear();
     stream.seekg(0, std::ios::end);
     const auto file_size = static_cast<std::uint64_t>(stream.tellg());
@@ -97,13 +112,13 @@ Status check_ply_header(const std::string& path) {
         if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF files
         const std::vector<std::string> words = words_of(line);
         const std::string keyword = words.empty() ? std::string() : words.front();
-        // Comments are free text: any bytes but line breaks.
-        if (keyword == "comment" || keyword == "obj_info") continue;
-        if (!is_plain_text(line)) return malformed(line_number, "a control or non-ASCII byte outside a comment");
         if (line_number == 1) {
             if (line != "ply") return malformed(line_number, "the first line must be exactly \"ply\"");
             continue;
         }
+        // Comments are free text: any bytes but line breaks.
+        if (keyword == "comment" || keyword == "obj_info") continue;
+        if (!is_plain_text(line)) return malformed(line_number, "a control or non-ASCII byte outside a comment");
         if (line_number == 2) {
             const bool known = words.size() == 3 && words[0] == "format" &&
                                (words[1] == "ascii" || words[1] == "binary_little_endian" ||
@@ -138,6 +153,7 @@ Status check_ply_header(const std::string& path) {
             return malformed(line_number, "unknown keyword \"" + keyword + "\"");
         }
     }
+    if (line_number == 0) return Error("empty PLY file", path);
     // assimp 5.2 never stops looking for the end of such a header.
     return Error("PLY header has no end_header line", path, line_number);
 }

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <string>
 #include <utility>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -110,7 +111,8 @@ TEST(ImportRegressions, PlyWithGarbageAfterTheMagicIsChecked) {
 // end_header (found by fuzz_ply): the header check matches the magic as loosely, then wants a proper "ply" line.
 TEST(ImportRegressions, PlyMagicInAnyCaseOrAfterLineBreaksIsChecked) {
     const ScratchFolder folder("ply_loose_magic");
-    for (const std::string prefix : {"plY", "PLY", "\nply", "\r\n\nply", "\tply"}) {
+    const std::vector<std::string> prefixes{"plY", "PLY", "\nply", "\r\n\nply", "\tply", std::string("\0\0\0\5\nply", 8)};
+    for (const std::string& prefix : prefixes) {
         SCOPED_TRACE(prefix);
         const std::string path = folder.write(
             "open.ply", prefix + "\nformat binary_little_endply\nformat ascii 1.0\nelement vertex 4\npria");
