@@ -10,6 +10,7 @@
 #include <fstream>
 #include <istream>
 #include <limits>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -58,6 +59,7 @@ bool parse_count(std::string_view text, std::uint64_t saturated, std::uint64_t& 
     return true;
 }
 
+/// True when the file name ends in ".ply", in any case: assimp then reads it as PLY whatever it holds.
 bool is_named_ply(const std::string& path) {
     std::string extension = std::filesystem::path(path).extension().string();
     for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
@@ -67,8 +69,7 @@ bool is_named_ply(const std::string& path) {
 /// True when the first bytes that are neither whitespace nor control characters spell "ply" in any case.
 bool starts_like_ply(std::istream& stream) {
     char c = 0;
-    while (stream.get(c) && (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f)) {
-    }
+    while (stream.get(c) && (static_cast<unsigned char>(c) <= 0x20 || c == 0x7f)) continue;
     std::string magic(1, c);
     for (int i = 0; i < 2 && stream.get(c); ++i) magic += c;
     for (char& m : magic) m = static_cast<char>(std::tolower(static_cast<unsigned char>(m)));
@@ -99,7 +100,8 @@ Status check_ply_header(const std::string& path) {
     auto close_element = [&] {
         if (!in_element) return;
         const std::uint64_t per_instance = std::max<std::uint64_t>(1, property_count);
-        needed = element_count > (saturated - needed) / per_instance ? saturated : needed + element_count * per_instance;
+        const bool overflows = element_count > (saturated - needed) / per_instance;
+        needed = overflows ? saturated : needed + element_count * per_instance;
     };
     auto malformed = [&](int line_number, const std::string& problem) {
         return Error("malformed PLY header: " + problem, path, line_number);
@@ -112,20 +114,23 @@ Status check_ply_header(const std::string& path) {
         if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF files
         const std::vector<std::string> words = words_of(line);
         const std::string keyword = words.empty() ? std::string() : words.front();
+        // assimp reads the magic and the format as the first two lines, whatever else they hold.
         if (line_number == 1) {
             if (line != "ply") return malformed(line_number, "the first line must be exactly \"ply\"");
+            continue;
+        }
+        if (line_number == 2) {
+            const bool known = words.size() == 3 && words[0] == "format" &&
+                               (words[1] == "ascii" || words[1] == "binary_little_endian" ||
+                                words[1] == "binary_big_endian");
+            if (!known || !is_plain_text(line))
+                return malformed(line_number, "the second line must be \"format ascii|binary_little_endian|"
+                                              "binary_big_endian VERSION\"");
             continue;
         }
         // Comments are free text: any bytes but line breaks.
         if (keyword == "comment" || keyword == "obj_info") continue;
         if (!is_plain_text(line)) return malformed(line_number, "a control or non-ASCII byte outside a comment");
-        if (line_number == 2) {
-            const bool known = words.size() == 3 && words[0] == "format" &&
-                               (words[1] == "ascii" || words[1] == "binary_little_endian" ||
-                                words[1] == "binary_big_endian");
-            if (!known) return malformed(line_number, "the second line must be \"format ascii|binary_little_endian|binary_big_endian VERSION\"");
-            continue;
-        }
         if (keyword == "element") {
             close_element();
             if (words.size() != 3 || !parse_count(words[2], saturated, element_count))
@@ -135,7 +140,8 @@ Status check_ply_header(const std::string& path) {
         } else if (keyword == "property") {
             if (!in_element) return malformed(line_number, "a property before any element");
             const bool scalar = words.size() == 3 && is_scalar_type(words[1]);
-            const bool list = words.size() == 5 && words[1] == "list" && is_scalar_type(words[2]) && is_scalar_type(words[3]);
+            const bool list =
+                words.size() == 5 && words[1] == "list" && is_scalar_type(words[2]) && is_scalar_type(words[3]);
             if (!scalar && !list)
                 return malformed(line_number, "expected \"property TYPE NAME\" or \"property list TYPE TYPE NAME\"");
             ++property_count;

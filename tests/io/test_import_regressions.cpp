@@ -111,7 +111,8 @@ TEST(ImportRegressions, PlyWithGarbageAfterTheMagicIsChecked) {
 // end_header (found by fuzz_ply): the header check matches the magic as loosely, then wants a proper "ply" line.
 TEST(ImportRegressions, PlyMagicInAnyCaseOrAfterLineBreaksIsChecked) {
     const ScratchFolder folder("ply_loose_magic");
-    const std::vector<std::string> prefixes{"plY", "PLY", "\nply", "\r\n\nply", "\tply", std::string("\0\0\0\5\nply", 8)};
+    const std::vector<std::string> prefixes{"plY",   "PLY", "\nply", "\r\n\nply",
+                                            "\tply", std::string("\0\0\0\5\nply", 8)};
     for (const std::string& prefix : prefixes) {
         SCOPED_TRACE(prefix);
         const std::string path = folder.write(
@@ -136,6 +137,7 @@ TEST(ImportRegressions, PlyHeaderGrammarIsChecked) {
         {start + "property floot y\nend_header\n0 0\n", "expected \"property TYPE NAME\""},
         {start + "element face -1\nend_header\n0\n", "expected \"element NAME COUNT\""},
         {"ply\nproperty float x\nend_header\n0\n", "the second line must be"},
+        {"ply\ncomment first\nformat ascii 1.0\nend_header\n", "the second line must be"},
         {"ply\nformat ascii 1.0\nproperty float x\nend_header\n0\n", "a property before any element"},
     };
     for (const auto& [text, problem] : cases) {
