@@ -47,6 +47,16 @@ bool is_plain_text(std::string_view line) {
     });
 }
 
+/// True for a name that starts with a letter or '_' and goes on with letters, digits, '_', '-' or '.'. assimp reads
+/// a name that starts with digits partly as a number ("element 2222...2222face 1" made it allocate 57 GB, found
+/// by fuzzing), and no PLY writer names elements or properties that way.
+bool is_name(std::string_view word) {
+    const auto is_letter = [](char c) { return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || c == '_'; };
+    if (word.empty() || !is_letter(word.front())) return false;
+    return std::all_of(word.begin(), word.end(),
+                       [&](char c) { return is_letter(c) || (c >= '0' && c <= '9') || c == '-' || c == '.'; });
+}
+
 /// The count of an element line: decimal digits only, saturated instead of overflowing (assimp reads overlong
 /// numbers too; the size check then refuses the file).
 bool parse_count(std::string_view text, std::uint64_t saturated, std::uint64_t& count) {
@@ -133,15 +143,15 @@ Status check_ply_header(const std::string& path) {
         if (!is_plain_text(line)) return malformed(line_number, "a control or non-ASCII byte outside a comment");
         if (keyword == "element") {
             close_element();
-            if (words.size() != 3 || !parse_count(words[2], saturated, element_count))
+            if (words.size() != 3 || !is_name(words[1]) || !parse_count(words[2], saturated, element_count))
                 return malformed(line_number, "expected \"element NAME COUNT\"");
             property_count = 0;
             in_element = true;
         } else if (keyword == "property") {
             if (!in_element) return malformed(line_number, "a property before any element");
-            const bool scalar = words.size() == 3 && is_scalar_type(words[1]);
-            const bool list =
-                words.size() == 5 && words[1] == "list" && is_scalar_type(words[2]) && is_scalar_type(words[3]);
+            const bool scalar = words.size() == 3 && is_scalar_type(words[1]) && is_name(words[2]);
+            const bool list = words.size() == 5 && words[1] == "list" && is_scalar_type(words[2]) &&
+                              is_scalar_type(words[3]) && is_name(words[4]);
             if (!scalar && !list)
                 return malformed(line_number, "expected \"property TYPE NAME\" or \"property list TYPE TYPE NAME\"");
             ++property_count;

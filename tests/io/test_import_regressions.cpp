@@ -136,6 +136,8 @@ TEST(ImportRegressions, PlyHeaderGrammarIsChecked) {
         {start + "elemfo float y\nend_header\n0\n", "unknown keyword \"elemfo\""},
         {start + "property floot y\nend_header\n0 0\n", "expected \"property TYPE NAME\""},
         {start + "element face -1\nend_header\n0\n", "expected \"element NAME COUNT\""},
+        {start + "element 2222222222face 1\nend_header\n0\n", "expected \"element NAME COUNT\""},
+        {start + "property float 9y\nend_header\n0 0\n", "expected \"property TYPE NAME\""},
         {"ply\nproperty float x\nend_header\n0\n", "the second line must be"},
         {"ply\ncomment first\nformat ascii 1.0\nend_header\n", "the second line must be"},
         {"ply\nformat ascii 1.0\nproperty float x\nend_header\n0\n", "a property before any element"},
