@@ -5,7 +5,11 @@
 
 #include <map>
 #include <mutex>
+#include <optional>
+#include <set>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include <console_bridge/console.h>
 #include <urdf_parser/urdf_parser.h>
@@ -111,7 +115,11 @@ public:
             const std::string link_name = link_element.attribute("name").as_string("");
             urdf::LinkConstSharedPtr link = model->getLink(link_name);
             if (!link) continue;
-            const RigidTransform world_from_link = link_frame(link);
+            const std::optional<RigidTransform> frame = link_frame(link);
+            if (!frame)
+                return source_->error_at(link_element,
+                                         "link '" + link_name + "' is its own ancestor: its joints form a cycle");
+            const RigidTransform& world_from_link = *frame;
             const std::vector<CollisionSite>& sites = collisions_[link_name];
             if (sites.size() != link->collision_array.size())
                 return source_->error_at(link_element, "urdfdom read a different number of collisions");
@@ -179,13 +187,29 @@ private:
     }
 
     // World frame of a link: its parent's frame times the joint origin, memoised (joints at q = 0 add nothing).
-    RigidTransform link_frame(const urdf::LinkConstSharedPtr& link) {
-        if (const auto known = frames_.find(link->name); known != frames_.end()) return known->second;
-        RigidTransform frame;
-        const urdf::JointConstSharedPtr joint = link->parent_joint;
-        urdf::LinkConstSharedPtr parent = link->getParent();
-        if (joint && parent) frame = link_frame(parent) * to_transform(joint->parent_to_joint_origin_transform);
-        frames_[link->name] = frame;
+    // Empty when the link is its own ancestor: urdfdom 3 accepts a joint whose parent and child are the same link
+    // when the model has another root, and the recursion this replaced overflowed the stack (found by fuzz_urdf).
+    std::optional<RigidTransform> link_frame(const urdf::LinkConstSharedPtr& link) {
+        // Stage 1: up the tree to a link whose frame is known, or to the root.
+        std::vector<urdf::LinkConstSharedPtr> chain;
+        std::set<std::string> on_chain;
+        RigidTransform frame;  // the root's: identity
+        for (urdf::LinkConstSharedPtr at = link; at;) {
+            if (const auto known = frames_.find(at->name); known != frames_.end()) {
+                frame = known->second;
+                break;
+            }
+            if (!on_chain.insert(at->name).second) return std::nullopt;
+            chain.push_back(at);
+            at = at->parent_joint ? at->getParent() : nullptr;
+        }
+        // Stage 2: back down, composing each joint's origin.
+        for (auto it = chain.rbegin(); it != chain.rend(); ++it) {
+            const urdf::LinkConstSharedPtr& child = *it;
+            if (child->parent_joint && child->getParent())
+                frame = frame * to_transform(child->parent_joint->parent_to_joint_origin_transform);
+            frames_[child->name] = frame;
+        }
         return frame;
     }
 

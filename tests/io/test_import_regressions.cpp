@@ -194,6 +194,22 @@ TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
 // Sizes and positions near the limit of double were accepted although the volume could not be written (a half
 // size of 1e308 is a full size of inf), so `hbvh convert` wrote files hbvh could not read. Found with the fuzz
 // targets' round-trip property.
+// urdfdom 3 accepts a joint whose parent and child are the same link when another link is the root; composing
+// that link's frame recursed forever (stack overflow, found by fuzz_urdf).
+TEST(ImportRegressions, UrdfLinkThatIsItsOwnParentIsRefused) {
+    const ScratchFolder folder("urdf_cycle");
+    const std::string path = folder.write(
+        "robot.urdf",
+        "<robot name=\"r\">\n<link name=\"base\"/>\n"
+        "<link name=\"lower\"><collision><geometry><sphere radius=\"1\"/></geometry></collision></link>\n"
+        "<joint name=\"elbow\" type=\"fixed\"><parent link=\"lower\"/><child link=\"lower\"/></joint>\n"
+        "</robot>\n");
+    const Result<ImportResult> imported = import_urdf(path);
+    ASSERT_FALSE(imported.has_value());
+    EXPECT_EQ(imported.error().line, 3);
+    EXPECT_NE(imported.error().message.find("its own ancestor"), std::string::npos) << imported.error().message;
+}
+
 TEST(ImportRegressions, OverflowingGeometryIsRefused) {
     const ScratchFolder folder("overflow");
     for (const std::string geom : {"<geom type=\"box\" size=\"1e308 1 1\"/>",
