@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <system_error>
@@ -131,6 +132,12 @@ Status write_file_atomic(const std::filesystem::path& path, std::string_view con
         ::close(directory_fd);
     }
     return Ok{};
+}
+
+std::string lower_case_extension(const std::filesystem::path& path) {
+    std::string extension = path.extension().string();
+    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return extension;
 }
 
 }  // namespace hbvh

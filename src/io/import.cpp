@@ -4,8 +4,8 @@
 
 #include <algorithm>
 #include <array>
-#include <filesystem>
 
+#include "hbvh/io/file.hpp"
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/mjcf.hpp"
 #include "hbvh/io/urdf.hpp"
@@ -16,9 +16,7 @@ namespace hbvh {
 namespace {
 
 Result<ImportFormat> format_from_path(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    std::transform(extension.begin(), extension.end(), extension.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string extension = lower_case_extension(path);
     if (extension == ".urdf") return ImportFormat::urdf;
     static constexpr std::array<std::string_view, 7> mesh_extensions{".gltf", ".glb", ".obj", ".fbx",
                                                                      ".dae",  ".stl", ".ply"};

@@ -6,13 +6,14 @@
 #include <array>
 #include <cctype>
 #include <cstdint>
-#include <filesystem>
 #include <fstream>
 #include <istream>
 #include <limits>
 #include <string>
 #include <string_view>
 #include <vector>
+
+#include "hbvh/io/file.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -69,13 +70,6 @@ bool parse_count(std::string_view text, std::uint64_t saturated, std::uint64_t& 
     return true;
 }
 
-/// True when the file name ends in ".ply", in any case: assimp then reads it as PLY whatever it holds.
-bool is_named_ply(const std::string& path) {
-    std::string extension = std::filesystem::path(path).extension().string();
-    for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return extension == ".ply";
-}
-
 /// True when the first bytes that are neither whitespace nor control characters spell "ply" in any case.
 bool starts_like_ply(std::istream& stream) {
     char c = 0;
@@ -93,7 +87,7 @@ Status check_ply_header(const std::string& path) {
     // assimp reads a file as PLY when it is named .ply, and otherwise when it starts with "ply" in any case, even
     // after leading control bytes ("plY", "\nply" and "\0\0\0\5\nply" all hung it, found by fuzzing). Every such
     // file must be proper PLY, whose first line is "ply".
-    if (!is_named_ply(path) && !starts_like_ply(stream)) return Ok{};
+    if (lower_case_extension(path) != ".ply" && !starts_like_ply(stream)) return Ok{};
     stream.clear();
     stream.seekg(0, std::ios::end);
     const auto file_size = static_cast<std::uint64_t>(stream.tellg());

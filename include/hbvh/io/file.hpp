@@ -21,4 +21,8 @@ namespace hbvh {
 /// 0666 & ~umask. A symbolic link at `path` is replaced by the file, not followed. POSIX only.
 [[nodiscard]] Status write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
+/// The extension of `path` with its dot, in ASCII lower case (".ply" for "Mesh.PLY"); empty when it has none.
+/// Formats are chosen by extension case-insensitively, as assimp chooses its readers.
+[[nodiscard]] std::string lower_case_extension(const std::filesystem::path& path);
+
 }  // namespace hbvh
