@@ -100,3 +100,25 @@ add_test(NAME cli.compare_gap
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
                  -P ${CMAKE_CURRENT_LIST_DIR}/compare_gap.cmake)
 set_tests_properties(cli.compare_gap PROPERTIES TIMEOUT 900)
+
+# hbvh collide: a pose that is no rigid motion is a usage error (exit 2) whose message names the flag; checked
+# before any file is read.
+set(HBVH_CLI_PAIRS ${HBVH_CLI_INPUTS}/collide_pairs.xml)
+function(hbvh_cli_bad_pose name flag pose regex)
+  hbvh_cli_test(collide.pose.${name} 2 "${flag}${regex}" collide ${HBVH_CLI_PAIRS} ${HBVH_CLI_PAIRS} ${flag} "${pose}")
+endfunction()
+hbvh_cli_bad_pose(two_numbers --pose-b "1 2" " needs 3 numbers")
+hbvh_cli_bad_pose(four_numbers --pose-a "1 2 3 4" " needs 3 numbers")
+hbvh_cli_bad_pose(eight_numbers --pose-b "1 2 3 1 0 0 0 5" " needs 3 numbers")
+hbvh_cli_bad_pose(nan --pose-b "nan 0 0" ": 'nan' is not a finite number")
+hbvh_cli_bad_pose(inf --pose-a "0 inf 0" ": 'inf' is not a finite number")
+hbvh_cli_bad_pose(inf_quaternion --pose-b "0 0 0 1 -inf 0 0" ": '-inf' is not a finite number")
+hbvh_cli_bad_pose(overflow --pose-b "1e999 0 0" ": '1e999' is not a finite number")
+hbvh_cli_bad_pose(not_a_number --pose-a "0 0 x" ": 'x' is not a finite number")
+hbvh_cli_bad_pose(trailing_garbage --pose-b "0 0 1m" ": '1m' is not a finite number")
+hbvh_cli_bad_pose(zero_quaternion --pose-b "1 0 0 0 0 0 0" ": the quaternion is zero")
+# The pairs under given poses against pairs worked out by hand, --first, a separating pose, a stored hierarchy
+# and bad input files (exit 1).
+add_test(NAME cli.collide
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
+                 -DWORK=${HBVH_CLI_OUT}/collide -P ${CMAKE_CURRENT_LIST_DIR}/collide.cmake)
