@@ -217,16 +217,65 @@ TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
     EXPECT_LT(work.primitive_tests, work.primitive_pairs / 2);
 }
 
+/// Edges on the longest root-to-leaf path below node `index`, counted here rather than by the library.
+std::uint32_t height_below(const Bvh& bvh, std::uint32_t index) {
+    const Node& node = bvh.nodes[index];
+    std::uint32_t height = 0;
+    for (std::uint32_t c = 0; c < node.child_count; ++c)
+        height = std::max(height, 1 + height_below(bvh, node.first_child + c));
+    return height;
+}
+
+/// Every primitive pair, both primitives moved to the world by their own object's pose: the definition of
+/// the answer, independent of relative_transform and of the query's frame.
+Pairs world_brute_force(const Bvh& a, const RigidTransform& pose_a, const Bvh& b, const RigidTransform& pose_b) {
+    Pairs pairs;
+    for (std::uint32_t i = 0; i < a.primitives.size(); ++i) {
+        const BoundingVolume world_a = transformed(a.primitives[i].volume, pose_a);
+        for (std::uint32_t j = 0; j < b.primitives.size(); ++j)
+            if (overlaps(world_a, transformed(b.primitives[j].volume, pose_b))) pairs.emplace_back(i, j);
+    }
+    return pairs;  // ascending by construction
+}
+
 TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {
+    // Multi-level trees (a one-level tree would leave the traversal's descent untested), from builders
+    // that merge, split and insert differently.
     const auto prims = generate_scene({.count = 13, .seed = 21});
-    const Bvh bvh = build(prims, algorithms().front().algorithm).value();
+    const auto others = generate_scene({.count = 9, .seed = 22});
+    for (const Algorithm algorithm :
+         {Algorithm::split, Algorithm::insertion, Algorithm::merge, Algorithm::bnb_exact, Algorithm::scale}) {
+        const std::string name(to_string(algorithm));
+        const Bvh bvh = build(prims, algorithm).value();
+        const Bvh other = build(others, algorithm).value();
+        ASSERT_GE(height_below(bvh, 0), 2u) << name;
+        ASSERT_GE(height_below(other, 0), 2u) << name;
+        const RigidTransform pose = RigidTransform::identity();
+        // Identical poses: every primitive touches at least itself.
+        const CollideResult r = collide(bvh, pose, bvh, pose, CollideMode::all);
+        EXPECT_TRUE(r.intersecting) << name;
+        for (std::uint32_t i = 0; i < prims.size(); ++i)
+            EXPECT_TRUE(std::binary_search(r.pairs.begin(), r.pairs.end(), std::pair{i, i})) << name << " " << i;
+        EXPECT_EQ(r.pairs, world_brute_force(bvh, pose, bvh, pose)) << name;
+        // Random poses, the two objects interpenetrating to varying depths.
+        int hits = 0;
+        for (std::uint64_t k = 0; k < 40; ++k) {
+            const RigidTransform pose_a = random_transform(300 + k, 10.0);
+            const RigidTransform pose_b = pose_near(bvh, pose_a, other, 900 + k, k % 2 == 0 ? 0.3 : 1.0);
+            const Pairs expected = world_brute_force(bvh, pose_a, other, pose_b);
+            const std::string where = name + " pose " + std::to_string(k);
+            const CollideResult all = collide(bvh, pose_a, other, pose_b, CollideMode::all);
+            EXPECT_EQ(all.pairs, expected) << where;
+            EXPECT_EQ(all.intersecting, !expected.empty()) << where;
+            EXPECT_EQ(collide(bvh, pose_a, other, pose_b, CollideMode::first).intersecting, !expected.empty()) << where;
+            EXPECT_EQ(collide_two_level(bvh, pose_a, other, pose_b, CollideMode::all).pairs, expected) << where;
+            hits += expected.empty() ? 0 : 1;
+        }
+        EXPECT_GT(hits, 0) << name;   // the poses produce contacts
+        EXPECT_LT(hits, 40) << name;  // and misses
+    }
+    const Bvh bvh = build(prims, Algorithm::split).value();
     const RigidTransform pose = RigidTransform::identity();
-    // Identical poses: every primitive touches at least itself.
-    const CollideResult r = collide(bvh, pose, bvh, pose, CollideMode::all);
-    EXPECT_TRUE(r.intersecting);
-    for (std::uint32_t i = 0; i < prims.size(); ++i)
-        EXPECT_TRUE(std::binary_search(r.pairs.begin(), r.pairs.end(), std::pair{i, i}));
-    EXPECT_EQ(r.pairs, collide_two_level(bvh, pose, bvh, pose, CollideMode::all).pairs);
     const Bvh empty;
     EXPECT_FALSE(collide(empty, pose, bvh, pose).intersecting);
     EXPECT_FALSE(collide_two_level(bvh, pose, empty, pose).intersecting);
