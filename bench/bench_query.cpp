@@ -1,11 +1,14 @@
 // SPDX-License-Identifier: MIT
 // Query time per pose: tandem traversal (every registered builder) vs the two-level baseline, on
-// generated scenes whose roots overlap, with the work counters and a checksum of the answers.
+// generated scenes whose roots overlap, with the work counters and a checksum of the answers. Every
+// method's answers are first compared with brute force over primitive pairs: a wrong answer fails the run.
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <map>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hbvh/build/build.hpp"
@@ -14,15 +17,33 @@
 #include "hbvh/scene/generate.hpp"
 
 namespace hbvh {
+namespace bench {
+/// Defined in bench/main.cpp: SkipWithError, and remember to exit non-zero (Google Benchmark exits 0).
+void fail(benchmark::State& state, const std::string& message);
+}  // namespace bench
+
 namespace {
 
+using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
+
 /// Two copies of one generated object and 256 seeded poses of the second copy whose root BVs overlap
-/// the first's (the survey's measuring condition), the first copy at the identity.
+/// the first's (the survey's measuring condition), the first copy at the identity; and, per pose, the
+/// overlapping primitive pairs by brute force, the answer every method must give.
 struct QueryScenario {
     Bvh bvh;
     QueryTree tree;
     std::vector<RigidTransform> poses;
+    std::vector<Pairs> expected;
 };
+
+/// Every primitive pair tested with overlaps(), the second copy moved by `pose`; ascending.
+Pairs brute_force_pairs(std::span<const Primitive> primitives, const RigidTransform& pose) {
+    Pairs pairs;
+    for (std::uint32_t i = 0; i < primitives.size(); ++i)
+        for (std::uint32_t j = 0; j < primitives.size(); ++j)
+            if (overlaps(primitives[i].volume, transformed(primitives[j].volume, pose))) pairs.emplace_back(i, j);
+    return pairs;
+}
 
 QueryScenario make_scenario(std::uint32_t count, Algorithm algorithm) {
     const auto primitives = generate_scene({.count = count, .seed = 2024});
@@ -40,7 +61,9 @@ QueryScenario make_scenario(std::uint32_t count, Algorithm algorithm) {
         const RigidTransform pose{rotation, center + offset - rotation * center};
         if (overlaps(bvh.root().volume, transformed(bvh.root().volume, pose))) poses.push_back(pose);
     }
-    return {std::move(bvh), std::move(tree), std::move(poses)};
+    std::vector<Pairs> expected;
+    for (const RigidTransform& pose : poses) expected.push_back(brute_force_pairs(primitives, pose));
+    return {std::move(bvh), std::move(tree), std::move(poses), std::move(expected)};
 }
 
 /// Scenarios are built on first use (so that filtered runs skip the building) and kept for later runs.
@@ -55,14 +78,30 @@ template <bool two_level>
 void run_queries(benchmark::State& state, const QueryScenario& scenario, CollideMode mode) {
     CollideResult result;
     const RigidTransform identity = RigidTransform::identity();
-    // Checksum of the answers over one full cycle of poses: equal across methods when they agree.
+    // One full cycle of poses before timing: every answer checked against brute force (`all`: the same
+    // pairs; `first`: a hit exactly when there is one, and a pair that really overlaps), and a checksum
+    // of the answers (equal across methods in `all` mode).
     std::uint64_t checksum = 0;
-    for (const RigidTransform& pose : scenario.poses) {
+    for (std::size_t p = 0; p < scenario.poses.size(); ++p) {
+        const RigidTransform& pose = scenario.poses[p];
         if constexpr (two_level)
             collide_two_level(scenario.tree, identity, scenario.tree, pose, mode, result);
         else
             collide(scenario.tree, identity, scenario.tree, pose, mode, result);
         for (const auto& [i, j] : result.pairs) checksum += 31u * i + j + 1u;
+        const Pairs& expected = scenario.expected[p];
+        const bool right = mode == CollideMode::all
+                               ? result.pairs == expected
+                               : result.intersecting == !expected.empty() &&
+                                     result.pairs.size() == (expected.empty() ? 0u : 1u) &&
+                                     (expected.empty() ||
+                                      std::binary_search(expected.begin(), expected.end(), result.pairs.front()));
+        if (!right) {
+            bench::fail(state, "wrong answer at pose " + std::to_string(p) + ": " +
+                                   std::to_string(result.pairs.size()) + " pairs, brute force finds " +
+                                   std::to_string(expected.size()));
+            return;
+        }
     }
     std::size_t k = 0;
     std::uint64_t queries = 0, bv_tests = 0, primitive_tests = 0, nodes = 0;
