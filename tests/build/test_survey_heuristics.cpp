@@ -138,22 +138,43 @@ TEST(SurveyHeuristics, InsertionDependsOnInputOrder) {
     }
 }
 
-TEST(SurveyHeuristics, BundledModels) {
+/// The *.xml files of `folder`, sorted.
+std::vector<std::filesystem::path> xml_files(const std::filesystem::path& folder) {
     std::vector<std::filesystem::path> files;
-    for (const char* dir : {HBVH_SOURCE_DIR "/data/models", HBVH_SHARED_DIR "/data/models"}) {
-        std::error_code error;
-        if (!std::filesystem::is_directory(dir, error)) continue;
-        for (const auto& entry : std::filesystem::directory_iterator(dir, error))
-            if (entry.path().extension() == ".xml") files.push_back(entry.path());
-    }
-    if (files.empty()) GTEST_SKIP() << "no data/models/*.xml";
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(folder, error))
+        if (entry.path().extension() == ".xml") files.push_back(entry.path());
     std::sort(files.begin(), files.end());
+    return files;
+}
+
+TEST(SurveyHeuristics, BundledModels) {
+    // Shipped with the repository: a missing or unreadable model is a failure.
+    const std::filesystem::path folder = std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models";
+    ASSERT_TRUE(std::filesystem::is_directory(folder)) << "missing bundled models: " << folder;
+    const auto files = xml_files(folder);
+    ASSERT_FALSE(files.empty()) << "no *.xml in " << folder;
     for (const auto& file : files) {
+        Result<XmlModel> model = read_xml_file(file);
+        ASSERT_TRUE(model.has_value()) << file << ": " << model.error().to_string();
+        SCOPED_TRACE(file.filename().string());
+        for (const Algorithm algorithm : heuristic_builders) check_properties(model->primitives, algorithm);
+    }
+}
+
+TEST(SurveyHeuristics, SharedModels) {
+    // ../shared is optional and also holds MJCF files: skip, saying why, when it has no hbvh model.
+    const std::filesystem::path folder = std::filesystem::path(HBVH_SHARED_DIR) / "data" / "models";
+    if (!std::filesystem::is_directory(folder)) GTEST_SKIP() << "no shared models at " << folder;
+    int checked = 0;
+    for (const auto& file : xml_files(folder)) {
         Result<XmlModel> model = read_xml_file(file);
         if (!model.has_value()) continue;  // not an hbvh model file (other formats share the folder)
         SCOPED_TRACE(file.filename().string());
         for (const Algorithm algorithm : heuristic_builders) check_properties(model->primitives, algorithm);
+        ++checked;
     }
+    if (checked == 0) GTEST_SKIP() << "no hbvh model file among the *.xml in " << folder;
 }
 
 }  // namespace
