@@ -12,6 +12,7 @@
 
 #include "capsule_bound.hpp"
 #include "fit_context.hpp"
+#include "rounding_pad.hpp"
 
 #include "hbvh/assert.hpp"
 
@@ -38,6 +39,16 @@ Aabb fit_aabb(std::span<const Sphere> spheres) {
     for (const Sphere& s : spheres) {
         const Vec3 r = Vec3::Constant(s.radius);
         box = box.merged({s.center - r, s.center + r});
+    }
+    // centre -/+ radius rounds to nearest, by up to half an ulp of |centre| + radius: grow outwards by the
+    // fitters' pad of the largest coordinate (which is at least that), so that the box contains every
+    // sphere even when re-evaluated with other rounding, and however far from the origin it sits.
+    // Per axis: a model spanning 1e150 in x but 1e-150 in y rounds y at 1e-150, and one pad for all axes
+    // would inflate the box's volume to infinity (tests/cli/inputs/mixed_scale.xml).
+    for (int axis = 0; axis < 3; ++axis) {
+        const double pad = detail::rounding_pad(std::max(std::abs(box.min[axis]), std::abs(box.max[axis])));
+        box.min[axis] -= pad;
+        box.max[axis] += pad;
     }
     return box;
 }

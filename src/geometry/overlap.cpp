@@ -10,33 +10,59 @@
 namespace hbvh {
 namespace {
 
-// Edge-edge SAT axes L = A_i x B_j vanish when the edges are parallel; then both sides of the test are
-// rounding noise of order u * |t|. A slack of 1e-13 of the configuration's size (about 500 u) keeps such a
-// degenerate axis from separating overlapping boxes (Ericson 4.4.1 adds an epsilon to |R| for the same
-// reason; an absolute slack keeps the test scale-free). On a genuine axis the slack is negligible.
-constexpr double edge_axis_slack = 1e-13;
+// Rounding relative to the coordinates. A rigid motion x -> R x + T rounds each coordinate at a few u
+// times |x| + |T| (u = 2^-53), so two volumes that touch, moved kilometres from the origin, arrive apart (or
+// apart by an ulp, overlapping) by ~10 u x |coordinates| whatever their size; computing t = b.center -
+// a.center rounds at u x |coordinates| again. Every test below therefore accepts separations up to a slack
+// proportional to the magnitude of the coordinates involved (L1 norms, cheap and >= the Euclidean ones),
+// not only to the volumes' sizes: touching counts anywhere in the world, and the extra pairs it reports
+// are within the documented band (docs/reliability.md, "Precision").
+
+// Box-box SAT, all 15 axes. Edge-edge axes L = A_i x B_j vanish when the edges are parallel; then both
+// sides of the test are rounding noise of order u * |t|. A slack of 1e-13 (about 450 u) of the
+// configuration's size and coordinates keeps such a degenerate axis from separating overlapping boxes
+// (Ericson 4.4.1 adds an epsilon to |R| for the same reason; an absolute slack keeps the test scale-free),
+// and covers the coordinate rounding above on the face axes. On a genuine axis the slack is negligible.
+constexpr double box_axis_slack = 1e-13;
 
 // boxes_may_overlap() must never separate boxes that overlaps() accepts, though it computes R and t in a
-// different order (b's axes moved into a's frame by one more product): 1e-12 of the size covers that
-// rounding (a few u times the size) with a wide margin and is still far below any real gap.
+// different order (b's axes moved into a's frame by one more product, the centre through another chain of
+// sums): 1e-12, ten times box_axis_slack on at least the same terms, covers that rounding (a few u times
+// size and coordinates) with a wide margin and is still far below any real gap.
 constexpr double face_axis_slack = 1e-12;
+
+// Round tests (and Aabb-Aabb) accept separations up to 1e-14 (about 45 u) of the coordinate magnitude plus
+// the reach: enough for the ~10-20 u a rigid motion (or pose composition) rounds, and the distance kernels'
+// own rounding relative to the reach; tight enough to keep extra pairs within ~1e-13 x |coordinates|.
+constexpr double round_slack = 1e-14;
 
 // Segment pairs with sin^2(angle) below this are "nearly parallel": the line-line solution loses
 // accuracy as u / sin(angle), so endpoint distances (exact for parallel segments) join the candidates.
 constexpr double parallel_sin2 = 1e-6;
 
-/// SAT core. B's axes in A's frame are R's columns (R(i, j) = A_i . B_j), t = B's centre in A's frame.
-bool boxes_overlap(const Vec3& ea, const Vec3& eb, const Mat3& R, const Vec3& t) {
+/// L1 norm: the coordinate magnitude the slacks are proportional to.
+inline double magnitude(const Vec3& v) { return v.cwiseAbs().sum(); }
+
+/// True when a squared distance is at most (reach + slack)^2: the round tests' comparison, conservative by
+/// round_slack of the coordinate magnitude `coordinates` and of the reach itself.
+inline bool within_reach(double squared_distance, double reach, double coordinates) {
+    const double r = reach + round_slack * (coordinates + reach);
+    return squared_distance <= r * r;
+}
+
+/// SAT core. B's axes in A's frame are R's columns (R(i, j) = A_i . B_j), t = B's centre in A's frame;
+/// `coordinates` is the magnitude of the coordinates t was computed from (|a.center| + |b.center|).
+bool boxes_overlap(const Vec3& ea, const Vec3& eb, const Mat3& R, const Vec3& t, double coordinates) {
     const Mat3 abs_r = R.cwiseAbs();
+    const double slack = box_axis_slack * (magnitude(t) + ea.sum() + eb.sum() + coordinates);
     // Stage 1: A's three face normals.
     for (int i = 0; i < 3; ++i)
-        if (std::abs(t[i]) > ea[i] + eb.dot(abs_r.row(i))) return false;
+        if (std::abs(t[i]) > ea[i] + eb.dot(abs_r.row(i)) + slack) return false;
     // Stage 2: B's three face normals.
     for (int j = 0; j < 3; ++j)
-        if (std::abs(t.dot(R.col(j))) > eb[j] + ea.dot(abs_r.col(j))) return false;
+        if (std::abs(t.dot(R.col(j))) > eb[j] + ea.dot(abs_r.col(j)) + slack) return false;
     // Stage 3: the nine edge-edge axes A_i x B_j, written out with the identities of orthonormal frames
     // so that no axis is formed explicitly (Gottschalk 1996; Ericson 4.4.1).
-    const double slack = edge_axis_slack * (t.cwiseAbs().sum() + ea.sum() + eb.sum());
     for (int i = 0; i < 3; ++i) {
         const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
         for (int j = 0; j < 3; ++j) {
@@ -72,14 +98,16 @@ inline double box_distance_slope(const Vec3& p, const Vec3& d, const Vec3& h, do
            d.z() * excess(p.z() + t * d.z(), h.z());
 }
 
-/// Capsule vs box with the capsule already in box coordinates.
-bool capsule_box_local(const Vec3& p0, const Vec3& p1, double radius, const Vec3& h) {
-    // Cheap exact rejection: both ends beyond the same slab face by more than the radius.
+/// Capsule vs box with the capsule already in box coordinates; `coordinates` as in within_reach (the
+/// world coordinates the local ones were computed from).
+bool capsule_box_local(const Vec3& p0, const Vec3& p1, double radius, const Vec3& h, double coordinates) {
+    const double slack = round_slack * (coordinates + h.sum() + radius);
+    // Cheap rejection: both ends beyond the same slab face by more than the radius (and the slack).
     for (int i = 0; i < 3; ++i) {
-        const double reach = h[i] + radius;
+        const double reach = h[i] + radius + slack;
         if ((p0[i] > reach && p1[i] > reach) || (p0[i] < -reach && p1[i] < -reach)) return false;
     }
-    return segment_box_squared_distance(p0, p1, h) <= radius * radius;
+    return within_reach(segment_box_squared_distance(p0, p1, h), radius, coordinates + h.sum());
 }
 
 }  // namespace
@@ -158,9 +186,9 @@ double segment_segment_squared_distance(const Vec3& p0, const Vec3& p1, const Ve
     return best;
 }
 
-bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t) {
+bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t, double coordinates) {
     const Mat3 abs_r = r.cwiseAbs();
-    const double slack = face_axis_slack * (t.cwiseAbs().sum() + ea.sum() + eb.sum());
+    const double slack = face_axis_slack * (magnitude(t) + ea.sum() + eb.sum() + coordinates);
     for (int i = 0; i < 3; ++i)
         if (std::abs(t[i]) > ea[i] + eb.dot(abs_r.row(i)) + slack) return false;
     for (int j = 0; j < 3; ++j)
@@ -169,53 +197,62 @@ bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3
 }
 
 bool overlaps(const Aabb& a, const Aabb& b) {
-    return (a.min.array() <= b.max.array()).all() && (b.min.array() <= a.max.array()).all();
+    // The comparisons themselves are exact; the slack is for the rounding that placed the boxes.
+    const double slack =
+        round_slack * (magnitude(a.min) + magnitude(a.max) + magnitude(b.min) + magnitude(b.max));
+    return (a.min.array() <= b.max.array() + slack).all() && (b.min.array() <= a.max.array() + slack).all();
 }
 
 bool overlaps(const Aabb& a, const Obb& b) {
     // The Aabb is an Obb with identity axes, so R is b's rotation and t stays in world axes.
-    return boxes_overlap(a.half_extents(), b.half_extents, b.rotation, b.center - a.center());
+    const Vec3 c = a.center();
+    return boxes_overlap(a.half_extents(), b.half_extents, b.rotation, b.center - c,
+                         magnitude(c) + magnitude(b.center));
 }
 
 bool overlaps(const Aabb& a, const Sphere& b) {
     // Ericson 5.2.5: the closest point of the box is the clamped centre.
     const Vec3 closest = b.center.cwiseMax(a.min).cwiseMin(a.max);
-    return (closest - b.center).squaredNorm() <= b.radius * b.radius;
+    return within_reach((closest - b.center).squaredNorm(), b.radius, magnitude(b.center) + magnitude(closest));
 }
 
 bool overlaps(const Aabb& a, const Capsule& b) {
     const Vec3 c = a.center();
-    return capsule_box_local(b.p0 - c, b.p1 - c, b.radius, a.half_extents());
+    return capsule_box_local(b.p0 - c, b.p1 - c, b.radius, a.half_extents(),
+                             magnitude(c) + magnitude(b.p0) + magnitude(b.p1));
 }
 
 bool overlaps(const Obb& a, const Obb& b) {
     const Mat3 rt = a.rotation.transpose();
-    return boxes_overlap(a.half_extents, b.half_extents, rt * b.rotation, rt * (b.center - a.center));
+    return boxes_overlap(a.half_extents, b.half_extents, rt * b.rotation, rt * (b.center - a.center),
+                         magnitude(a.center) + magnitude(b.center));
 }
 
 bool overlaps(const Obb& a, const Sphere& b) {
     const Vec3 local = a.rotation.transpose() * (b.center - a.center);
-    return point_box_squared_distance(local, a.half_extents) <= b.radius * b.radius;
+    return within_reach(point_box_squared_distance(local, a.half_extents), b.radius,
+                        magnitude(a.center) + magnitude(b.center) + a.half_extents.sum());
 }
 
 bool overlaps(const Obb& a, const Capsule& b) {
     const Mat3 rt = a.rotation.transpose();
-    return capsule_box_local(rt * (b.p0 - a.center), rt * (b.p1 - a.center), b.radius, a.half_extents);
+    return capsule_box_local(rt * (b.p0 - a.center), rt * (b.p1 - a.center), b.radius, a.half_extents,
+                             magnitude(a.center) + magnitude(b.p0) + magnitude(b.p1));
 }
 
 bool overlaps(const Sphere& a, const Sphere& b) {
-    const double r = a.radius + b.radius;
-    return (a.center - b.center).squaredNorm() <= r * r;
+    return within_reach((a.center - b.center).squaredNorm(), a.radius + b.radius,
+                        magnitude(a.center) + magnitude(b.center));
 }
 
 bool overlaps(const Sphere& a, const Capsule& b) {
-    const double r = a.radius + b.radius;
-    return point_segment_squared_distance(a.center, b.p0, b.p1) <= r * r;
+    return within_reach(point_segment_squared_distance(a.center, b.p0, b.p1), a.radius + b.radius,
+                        magnitude(a.center) + magnitude(b.p0) + magnitude(b.p1));
 }
 
 bool overlaps(const Capsule& a, const Capsule& b) {
-    const double r = a.radius + b.radius;
-    return segment_segment_squared_distance(a.p0, a.p1, b.p0, b.p1) <= r * r;
+    return within_reach(segment_segment_squared_distance(a.p0, a.p1, b.p0, b.p1), a.radius + b.radius,
+                        magnitude(a.p0) + magnitude(a.p1) + magnitude(b.p0) + magnitude(b.p1));
 }
 
 bool overlaps(const BoundingVolume& a, const BoundingVolume& b) {

@@ -8,8 +8,12 @@ namespace hbvh {
 
 // Every test takes both volumes in the same frame (any frame; world frame for the types' own
 // conventions). Touching counts as intersecting: the tests answer "is the closed sets' intersection
-// non-empty". All are allocation-free. Exactness: see docs/queries.md for the one documented
-// tolerance (the OBB-OBB edge-edge axes, conservative by <= 1e-13 of the boxes' size / sin(angle)).
+// non-empty", conservatively against rounding relative to the magnitude of the coordinates involved, not
+// only to the volumes' sizes (docs/reliability.md, "Precision"): never false for touching volumes however
+// far from the origin; true for separated ones only when the gap is below the slack, which is 1e-13 x
+// (|t|_1 + the half extents' sum + |centres|_1) for box-box pairs (also covering the edge-edge axes of
+// parallel edges, docs/queries.md) and 1e-14 x (the reach + |coordinates|_1) for every other pair. All
+// are allocation-free.
 
 /// Aabb vs Aabb: interval overlap on each world axis.
 [[nodiscard]] bool overlaps(const Aabb& a, const Aabb& b);
@@ -45,11 +49,14 @@ namespace hbvh {
 [[nodiscard]] bool overlaps(const BoundingVolume& a, const BoundingVolume& b);
 
 /// Conservative box-box test for traversals: the separating-axis test on the six face normals only
-/// (the nine edge-edge axes are skipped), with a slack of 1e-12 of the configuration's size so that
-/// rounding never separates touching boxes. Never false when overlaps() of the two boxes is true; may be
+/// (the nine edge-edge axes are skipped), with a slack of 1e-12 of (|t|_1 + the half extents' sums +
+/// `coordinates`) so that rounding never separates touching boxes. Never false when overlaps() of the two
+/// boxes is true, given `coordinates` >= the L1 magnitudes of the coordinates the boxes and t were computed
+/// from (both centres in the frame of the exact test, and the translation of any motion applied); may be
 /// true for separated boxes (only an edge-edge axis separates them). Box a is [-ea, ea] in its own
 /// frame; box b has half extents eb, axes R's columns (R(i, j) = A_i . B_j) and centre t in a's frame.
-[[nodiscard]] bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t);
+[[nodiscard]] bool boxes_may_overlap(const Vec3& ea, const Vec3& eb, const Mat3& r, const Vec3& t,
+                                     double coordinates);
 
 /// Squared distance between the segments p0-p1 and q0-q1 (any frame). Zero-length segments are points;
 /// parallel segments are handled exactly (the minimum over endpoint distances joins the line solution).
