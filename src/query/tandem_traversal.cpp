@@ -14,8 +14,11 @@
 namespace hbvh {
 namespace {
 
-// Enclosing spheres are padded so that rounding in their radius can never make the pre-test reject a
-// pair the exact test would accept.
+// Enclosing spheres are padded so that rounding can never make the pre-test reject a pair the exact test
+// would accept: rounding in the radius (relative to it), and in the centre, which a transform moves with an
+// error of a few ulps of its coordinates (a radius-1 sphere at 1e5 lands ~2e-11 off). The pad, 1e-12 of
+// radius + |centre|_1, dominates both and the exact tests' own slacks (<= 1e-13 of the coordinates,
+// geometry/overlap.cpp).
 constexpr double sphere_padding = 1e-12;
 
 /// Centre and radius of a sphere around the BV (not the smallest; cheap and tight enough to reject).
@@ -46,7 +49,7 @@ void enclosing_sphere(const BoundingVolume& bv, Vec3& center, double& radius) {
             break;
         }
     }
-    radius *= 1.0 + sphere_padding;
+    radius += sphere_padding * (radius + center.cwiseAbs().sum());
 }
 
 // The traversal reads one node per test: keep it compact (docs/queries.md, "Query layout").
@@ -96,6 +99,12 @@ inline bool spheres_meet(const QueryNode& x, const Vec3& other_center, double ot
     return (x.center - other_center).squaredNorm() <= r * r;
 }
 
+/// What boxes_may_overlap needs to know of the coordinates its centre was computed from: both nodes'
+/// centres in their model frames and the motion's translation (L1 norms), whose rounding it must cover.
+inline double coordinate_magnitude(const Vec3& center_a, const Vec3& center_b, const RigidTransform& t) {
+    return center_a.cwiseAbs().sum() + center_b.cwiseAbs().sum() + t.translation.cwiseAbs().sum();
+}
+
 /// Overlap of a's node ia and b's moved node once the spheres met: two leaves get the exact primitive
 /// test; inner pairs of boxes the six-face-axis test, which never rejects what the exact one accepts;
 /// two spheres are settled by the pre-test; other inner pairs get the exact test.
@@ -105,10 +114,11 @@ inline bool refined_overlap(const QueryTree& a, std::uint32_t ia, MovedNode& nb,
     if (na.child_count != 0 || b.child_count != 0) {
         if (is_box(na.type) && is_box(b.type)) {
             const Vec3 d = nb.center() - na.center;
+            const double coordinates = coordinate_magnitude(na.center, b.center, t) + nb.center().cwiseAbs().sum();
             if (na.type == BvType::aabb)  // identity axes: b's axes and centre are already in a's box frame
-                return boxes_may_overlap(na.half_extents, b.half_extents, nb.rotation(t), d);
+                return boxes_may_overlap(na.half_extents, b.half_extents, nb.rotation(t), d, coordinates);
             return boxes_may_overlap(na.half_extents, b.half_extents, na.rotation.transpose() * nb.rotation(t),
-                                     na.rotation.transpose() * d);
+                                     na.rotation.transpose() * d, coordinates);
         }
         if (na.type == BvType::sphere && b.type == BvType::sphere) return true;
     }
@@ -279,7 +289,9 @@ void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& 
                 if (is_box(node_a.type) && is_box(child.type) && (node_a.child_count != 0 || child.child_count != 0)) {
                     const Mat3 axes = to_box_a * child.rotation;
                     const Vec3 center = to_box_a * child.center + offset_a;
-                    if (!boxes_may_overlap(node_a.half_extents, child.half_extents, axes, center)) continue;
+                    const double coordinates = coordinate_magnitude(node_a.center, child.center, t);
+                    if (!boxes_may_overlap(node_a.half_extents, child.half_extents, axes, center, coordinates))
+                        continue;
                 } else {
                     MovedNode moved_c(b, c, t);
                     if (!refined_overlap(a, ia, moved_c, t)) continue;

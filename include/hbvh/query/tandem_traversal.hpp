@@ -32,7 +32,7 @@ struct CollideResult {
 /// from; everything in the Bvh's model frame. The exact BV lives in QueryTree::volume(i) (cold).
 struct QueryNode {
     Vec3 center;                    ///< Box / sphere centre, capsule midpoint; also the enclosing sphere's centre.
-    double sphere_radius = 0.0;     ///< Radius of a sphere around the BV, padded by 1e-12 relative.
+    double sphere_radius = 0.0;     ///< Radius of a sphere around the BV, padded by 1e-12 x (radius + |center|_1).
     Mat3 rotation;                  ///< Box axes as columns (identity for an Aabb); identity otherwise.
     Vec3 half_extents;              ///< Box half extents; zero otherwise.
     double measure = 0.0;           ///< volume(volume): the descent rule compares these.
