@@ -12,7 +12,9 @@
 
 #include "hbvh/build/optimal.hpp"
 #include "hbvh/build/two_level.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/stats.hpp"
+#include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
 namespace {
@@ -66,7 +68,13 @@ std::string range_message(const Vec3& extent, const char* problem) {
 // truly zero), so only a box of three positive extents whose volume is not a normal double is refused.
 Status check_finite_extent(std::span<const Primitive> primitives) {
     Aabb box = Aabb::empty();
-    for (const Primitive& primitive : primitives) box = box.merged(world_aabb(primitive.volume));
+    for (std::size_t i = 0; i < primitives.size(); ++i) {
+        // Eigen's cwiseMin/cwiseMax may skip a NaN operand, so a NaN box would vanish from the merge.
+        const Aabb own = world_aabb(primitives[i].volume);
+        if (!own.min.allFinite() || !own.max.allFinite())
+            return Error{"primitive " + std::to_string(i) + " has non-finite coordinates", "", 0};
+        box = box.merged(own);
+    }
     const Vec3 extent = box.max - box.min;
     const double volume = 8.0 * extent.x() * extent.y() * extent.z();
     if (!extent.allFinite() || !std::isfinite(volume))
@@ -205,9 +213,18 @@ std::string_view to_string(Algorithm algorithm) {
     return "unknown";
 }
 
-Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
-    if (Status finite = check_finite_extent(primitives); !finite) return finite.error();
+namespace {
+/// The builder's tree, or an Error when it is not one queries can use (a fitter that overflowed to NaN on
+/// extreme input once wrote "pos=-nan" into a file): a wrong tree is never handed on. Linear time.
+Result<Bvh> checked_output(Result<Bvh> built, Algorithm algorithm) {
+    if (!built) return built;
+    if (Status structure = check_structure(*built); !structure)
+        return Error{std::string(to_string(algorithm)) + " produced an unusable tree (" + structure.error().message +
+                     "); the input's scale is probably beyond what double precision can fit"};
+    return built;
+}
+
+Result<Bvh> build_unchecked(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
     if (algorithm == Algorithm::automatic) return build_auto(primitives, options);
     const auto start = std::chrono::steady_clock::now();
     Result<Bvh> built = build_one(primitives, algorithm, options);
@@ -217,6 +234,14 @@ Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, co
     Bvh refined = refine_treelets(built.value(), options.policy, treelet_options_within(options, elapsed), &treelets);
     if (options.report != nullptr) note_treelets(*options.report, treelets);
     return refined;
+}
+}  // namespace
+
+Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm, const BuildOptions& options) {
+    if (primitives.empty()) return Error{"no primitives to build a hierarchy over", "", 0};
+    if (Status valid = validate_primitives(primitives); !valid) return valid.error();
+    if (Status finite = check_finite_extent(primitives); !finite) return finite.error();
+    return checked_output(build_unchecked(primitives, algorithm, options), algorithm);
 }
 
 namespace {

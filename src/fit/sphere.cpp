@@ -27,16 +27,30 @@ using Traits2 = CGAL::Min_sphere_of_spheres_d_traits_2<Kernel, double>;
 
 Sphere fit_sphere(std::span<const Sphere> spheres) {
     HBVH_ASSERT(!spheres.empty());
+    // CGAL works on squares of squared distances, which overflow for spans beyond ~1e75 (a sphere at 1e150
+    // came back with a NaN centre): solve for the set moved to the origin and scaled to unit size, then undo.
+    Vec3 low = spheres.front().center, high = low;
+    double largest_radius = 0.0;
+    for (const Sphere& s : spheres) {
+        low = low.cwiseMin(s.center);
+        high = high.cwiseMax(s.center);
+        largest_radius = std::max(largest_radius, s.radius);
+    }
+    const Vec3 origin = 0.5 * (low + high);
+    const double span = std::max((high - low).maxCoeff(), largest_radius);
+    const double scale = span > 0.0 ? span : 1.0;
     std::vector<Traits3::Sphere> input;
     input.reserve(spheres.size());
-    for (const Sphere& s : spheres)
-        input.emplace_back(Kernel::Point_3(s.center.x(), s.center.y(), s.center.z()), s.radius);
+    for (const Sphere& s : spheres) {
+        const Vec3 c = (s.center - origin) / scale;
+        input.emplace_back(Kernel::Point_3(c.x(), c.y(), c.z()), s.radius / scale);
+    }
     CGAL::Min_sphere_of_spheres_d<Traits3> solver(input.begin(), input.end());
 
     Sphere result;
     auto coordinate = solver.center_cartesian_begin();
-    for (int k = 0; k < 3; ++k, ++coordinate) result.center[k] = *coordinate;
-    result.radius = solver.radius();
+    for (int k = 0; k < 3; ++k, ++coordinate) result.center[k] = *coordinate * scale + origin[k];
+    result.radius = solver.radius() * scale;
     // CGAL's answer is optimal up to rounding; measure containment the way Sphere::contains does and grow.
     for (const Sphere& s : spheres) result.radius = std::max(result.radius, (s.center - result.center).norm() + s.radius);
     // The distances are of nearby points, so their rounding scales with the radius, not the coordinates.

@@ -10,6 +10,8 @@
 
 #include "hbvh/assert.hpp"
 #include "hbvh/geometry/overlap.hpp"
+#include "hbvh/geometry/validation.hpp"
+#include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
 namespace {
@@ -161,6 +163,7 @@ private:
 
 void reset(CollideResult& result) {
     result.intersecting = false;
+    result.error.reset();
     result.pairs.clear();
     result.bv_tests = result.primitive_tests = result.nodes_visited = 0;
 }
@@ -177,9 +180,32 @@ inline bool counted_overlap(const QueryTree& a, std::uint32_t ia, MovedNode& nb,
     return node_overlap(a, ia, nb, t);
 }
 
+/// Refuses a query whose poses are no rigid motions; true when it may go on.
+bool poses_valid(const RigidTransform& pose_a, const RigidTransform& pose_b, CollideResult& result) {
+    for (const RigidTransform* pose : {&pose_a, &pose_b}) {
+        if (Status valid = validate_pose(*pose); !valid) {
+            result.error = Error{(pose == &pose_a ? "pose_a: " : "pose_b: ") + valid.error().message};
+            return false;
+        }
+    }
+    return true;
+}
+
 }  // namespace
 
-QueryTree::QueryTree(const Bvh& bvh) {
+QueryTree::Checked QueryTree::checked_or_throw(const Bvh& bvh) {
+    if (Status structure = check_structure(bvh); !structure) throw InvalidHierarchy(structure.error());
+    return Checked{};
+}
+
+QueryTree::QueryTree(const Bvh& bvh) : QueryTree(bvh, checked_or_throw(bvh)) {}
+
+Result<QueryTree> QueryTree::create(const Bvh& bvh) {
+    if (Status structure = check_structure(bvh); !structure) return structure.error();
+    return QueryTree(bvh, Checked{});
+}
+
+QueryTree::QueryTree(const Bvh& bvh, Checked) {
     nodes_.reserve(bvh.nodes.size());
     volumes_.reserve(bvh.nodes.size());
     primitive_nodes_.assign(bvh.primitives.size(), 0);
@@ -218,13 +244,16 @@ QueryTree::QueryTree(const Bvh& bvh) {
 }
 
 RigidTransform relative_transform(const RigidTransform& pose_a, const RigidTransform& pose_b) {
-    return pose_a.inverse() * pose_b;
+    // R_a^T (T_b - T_a), not R_a^T T_b - R_a^T T_a: two objects kilometres from the origin but close to each
+    // other then lose only the rounding of their small offset, not u x |T| of each (docs/reliability.md §5).
+    const Mat3 inverse_rotation = pose_a.rotation.transpose();
+    return {inverse_rotation * pose_b.rotation, inverse_rotation * (pose_b.translation - pose_a.translation)};
 }
 
 void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
              CollideMode mode, CollideResult& result) {
     reset(result);
-    if (a.empty() || b.empty()) return;
+    if (!poses_valid(pose_a, pose_b, result) || a.empty() || b.empty()) return;
     const RigidTransform t = relative_transform(pose_a, pose_b);
     const RigidTransform t_inverse = t.inverse();
     const std::span<const QueryNode> na = a.nodes(), nb = b.nodes();
@@ -315,15 +344,30 @@ CollideResult collide(const QueryTree& a, const RigidTransform& pose_a, const Qu
     return result;
 }
 
+namespace {
+/// Both Bvhs as QueryTrees and `query` on them, or the result that carries their Error.
+template <class Query>
+CollideResult on_query_trees(const Bvh& a, const Bvh& b, Query query) {
+    Result<QueryTree> tree_a = QueryTree::create(a);
+    Result<QueryTree> tree_b = tree_a ? QueryTree::create(b) : Result<QueryTree>(tree_a.error());
+    if (!tree_a || !tree_b) {
+        CollideResult refused;
+        refused.error = tree_a ? tree_b.error() : tree_a.error();
+        return refused;
+    }
+    return query(*tree_a, *tree_b);
+}
+}  // namespace
+
 CollideResult collide(const Bvh& a, const RigidTransform& pose_a, const Bvh& b, const RigidTransform& pose_b,
                       CollideMode mode) {
-    return collide(QueryTree(a), pose_a, QueryTree(b), pose_b, mode);
+    return on_query_trees(a, b, [&](const QueryTree& ta, const QueryTree& tb) { return collide(ta, pose_a, tb, pose_b, mode); });
 }
 
 void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
                        const RigidTransform& pose_b, CollideMode mode, CollideResult& result) {
     reset(result);
-    if (a.empty() || b.empty()) return;
+    if (!poses_valid(pose_a, pose_b, result) || a.empty() || b.empty()) return;
     const RigidTransform t = relative_transform(pose_a, pose_b);
     const std::span<const QueryNode> na = a.nodes(), nb = b.nodes();
     {
@@ -360,7 +404,9 @@ CollideResult collide_two_level(const QueryTree& a, const RigidTransform& pose_a
 
 CollideResult collide_two_level(const Bvh& a, const RigidTransform& pose_a, const Bvh& b,
                                 const RigidTransform& pose_b, CollideMode mode) {
-    return collide_two_level(QueryTree(a), pose_a, QueryTree(b), pose_b, mode);
+    return on_query_trees(a, b, [&](const QueryTree& ta, const QueryTree& tb) {
+        return collide_two_level(ta, pose_a, tb, pose_b, mode);
+    });
 }
 
 }  // namespace hbvh

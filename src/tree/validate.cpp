@@ -1,7 +1,11 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/tree/validate.hpp"
 
+#include <algorithm>
+#include <cstdio>
 #include <string>
+
+#include "hbvh/geometry/validation.hpp"
 
 namespace hbvh {
 namespace {
@@ -10,47 +14,87 @@ Error node_error(std::uint32_t index, const std::string& problem) {
 }
 }  // namespace
 
-Status validate(const Bvh& bvh, double relative_tolerance) {
+Status check_structure(const Bvh& bvh) {
     if (bvh.nodes.empty()) return bvh.primitives.empty() ? Status{Ok{}} : Status{Error{"hierarchy has no nodes"}};
-    const auto node_count = static_cast<std::uint32_t>(bvh.nodes.size());
-    std::vector<std::uint32_t> leaf_of(bvh.primitives.size(), node_count);  // node_count = not seen yet
-    std::vector<std::uint32_t> parent_count(node_count, 0);
-
+    if (bvh.nodes.size() >= UINT32_MAX) return Error{"hierarchy has more nodes than 32-bit indices can address"};
+    if (Status primitives = validate_primitives(bvh.primitives); !primitives) return primitives;
+    const auto node_count = static_cast<std::uint64_t>(bvh.nodes.size());
+    std::vector<std::uint32_t> leaf_of(bvh.primitives.size(), UINT32_MAX);  // UINT32_MAX = not seen yet
+    // Breadth-first: the inner nodes' child ranges, in index order, follow each other from node 1 on.
+    std::uint64_t next_child = 1;
     for (std::uint32_t i = 0; i < node_count; ++i) {
         const Node& node = bvh.nodes[i];
+        if (std::string problem = volume_problem(node.volume); !problem.empty()) return node_error(i, problem);
         if (node.is_leaf()) {
             if (node.primitive >= bvh.primitives.size()) return node_error(i, "leaf refers to a missing primitive");
-            if (leaf_of[node.primitive] != node_count)
+            if (leaf_of[node.primitive] != UINT32_MAX)
                 return node_error(i, "primitive " + std::to_string(node.primitive) + " appears in two leaves");
             leaf_of[node.primitive] = i;
             continue;
         }
         if (node.child_count < 2) return node_error(i, "inner node with a single child");
-        // Breadth-first order puts children after their parent; this also rules out cycles.
-        if (node.first_child <= i || node.first_child + node.child_count > node_count)
-            return node_error(i, "child range out of order or out of bounds");
-        for (std::uint32_t c = 0; c < node.child_count; ++c) ++parent_count[node.first_child + c];
+        if (std::uint64_t{node.first_child} + node.child_count > node_count)
+            return node_error(i, "child range past the end of the node array");
+        // This also rules out cycles and shared children: every child comes after its parent, once.
+        if (node.first_child != next_child)
+            return node_error(i, "children at " + std::to_string(node.first_child) + ", but breadth-first order puts them at " +
+                                     std::to_string(next_child));
+        next_child += node.child_count;
     }
-    for (std::uint32_t i = 1; i < node_count; ++i)
-        if (parent_count[i] != 1) return node_error(i, "has " + std::to_string(parent_count[i]) + " parents");
+    if (next_child != node_count)
+        return node_error(static_cast<std::uint32_t>(next_child), "is no node's child (nodes are not one breadth-first tree)");
     for (std::uint32_t p = 0; p < bvh.primitives.size(); ++p)
-        if (leaf_of[p] == node_count) return Error{"primitive " + std::to_string(p) + " is in no leaf"};
-
-    // Containment: a node's BV must hold every covered primitive, i.e. all their generating spheres.
-    std::vector<Sphere> spheres;
-    for (std::uint32_t i = 0; i < node_count; ++i) {
-        const Node& node = bvh.nodes[i];
-        const double tolerance = relative_tolerance * std::max(1.0, size_scale(node.volume));
-        for (std::uint32_t p : covered_primitives(bvh, i)) {
-            spheres.clear();
-            append_generating_spheres(bvh.primitives[p].volume, spheres);
-            for (const Sphere& s : spheres)
-                if (!contains(node.volume, s, tolerance))
-                    return node_error(i, "its " + std::string(to_string(type_of(node.volume))) +
-                                             " does not contain primitive " + std::to_string(p));
-        }
-    }
+        if (leaf_of[p] == UINT32_MAX) return Error{"primitive " + std::to_string(p) + " is in no leaf"};
     return Ok{};
+}
+
+double containment_tolerance(const BoundingVolume& volume, double relative_tolerance) {
+    const Aabb box = world_aabb(volume);
+    const double magnitude = std::max(box.min.cwiseAbs().maxCoeff(), box.max.cwiseAbs().maxCoeff());
+    return relative_tolerance * size_scale(volume) + 1e-14 * magnitude;
+}
+
+std::vector<ContainmentViolation> containment_violations(const Bvh& bvh, double relative_tolerance) {
+    std::vector<ContainmentViolation> violations;
+    std::vector<Sphere> spheres;
+    std::vector<std::uint32_t> stack;
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const Node& node = bvh.nodes[i];
+        const double tolerance = containment_tolerance(node.volume, relative_tolerance);
+        ContainmentViolation worst{i, 0, 0.0};
+        bool violated = false;
+        // The primitives below node i: a walk of its subtree (structure checked, so it ends).
+        stack.assign(1, i);
+        while (!stack.empty()) {
+            const Node& below = bvh.nodes[stack.back()];
+            stack.pop_back();
+            for (std::uint32_t c = 0; c < below.child_count; ++c) stack.push_back(below.first_child + c);
+            if (!below.is_leaf()) continue;
+            spheres.clear();
+            append_generating_spheres(bvh.primitives[below.primitive].volume, spheres);
+            for (const Sphere& s : spheres) {
+                const double reach = protrusion(node.volume, s);
+                if (reach > tolerance && (!violated || reach > worst.protrusion ||
+                                          (reach == worst.protrusion && below.primitive < worst.primitive))) {
+                    worst = {i, below.primitive, reach};
+                    violated = true;
+                }
+            }
+        }
+        if (violated) violations.push_back(worst);
+    }
+    return violations;
+}
+
+Status validate(const Bvh& bvh, double relative_tolerance) {
+    if (Status structure = check_structure(bvh); !structure) return structure;
+    const std::vector<ContainmentViolation> violations = containment_violations(bvh, relative_tolerance);
+    if (violations.empty()) return Ok{};
+    const ContainmentViolation& first = violations.front();
+    char by[32];
+    std::snprintf(by, sizeof by, "%.3g", first.protrusion);
+    return node_error(first.node, "its " + std::string(to_string(type_of(bvh.nodes[first.node].volume))) +
+                                      " does not contain primitive " + std::to_string(first.primitive) + " (by " + by + ")");
 }
 
 }  // namespace hbvh

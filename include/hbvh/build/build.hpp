@@ -111,8 +111,8 @@ inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 /// Appends a one-line summary of a treelet refinement to report.notes (and sets budget_hit on a time-out).
 void note_treelets(BuildReport& report, const TreeletReport& treelets);
 
-/// Builds a hierarchy over `primitives` (non-empty, already validated geometry).
-/// Returns an Error for an empty input.
+/// Builds a hierarchy over `primitives`. Returns an Error for an empty input, for geometry that
+/// validate_primitives() refuses (naming the primitive) and for a model check_finite_extent() refuses.
 [[nodiscard]] Result<Bvh> build(std::span<const Primitive> primitives, Algorithm algorithm,
                                 const BuildOptions& options = {});
 

@@ -46,6 +46,10 @@ inline constexpr std::array<BvType, bv_type_count> all_bv_types{BvType::aabb, Bv
 [[nodiscard]] BoundingVolume transformed(const BoundingVolume& bv, const RigidTransform& t);
 /// True when every point of `s` lies in `bv`, allowing `tolerance` (absolute length).
 [[nodiscard]] bool contains(const BoundingVolume& bv, const Sphere& s, double tolerance = 0.0);
+/// How far `s` reaches beyond `bv`: the largest distance by which a point of `s` lies outside one of the
+/// volume's faces (boxes) or outside its round surface (spheres, capsules); <= 0 when `s` is inside.
+/// contains(bv, s, tolerance) is protrusion(bv, s) <= tolerance, up to rounding.
+[[nodiscard]] double protrusion(const BoundingVolume& bv, const Sphere& s);
 /// Smallest world axis-aligned box around the BV (exact for every kind).
 [[nodiscard]] Aabb world_aabb(const BoundingVolume& bv);
 /// A length scale of the BV (half the diagonal of its world AABB), used to make tolerances relative.

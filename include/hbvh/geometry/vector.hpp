@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+#include <cmath>
+#include <limits>
 
 namespace hbvh {
 
@@ -25,6 +27,17 @@ struct RigidTransform {
         return {rotation * other.rotation, rotation * other.translation + translation};
     }
     [[nodiscard]] static RigidTransform identity() { return {}; }
+    /// The rotation of the quaternion (w, x, y, z), normalised first so that any non-zero quaternion gives a
+    /// proper rotation, then `translation`. A zero or non-finite quaternion gives a non-finite rotation,
+    /// which validate_pose() and collide() refuse.
+    [[nodiscard]] static RigidTransform from_quaternion(double w, double x, double y, double z,
+                                                        const Vec3& translation = Vec3::Zero()) {
+        const Eigen::Quaterniond q(w, x, y, z);
+        const double norm = q.norm();
+        if (!(norm > 0.0) || !std::isfinite(norm))
+            return {Mat3::Constant(std::numeric_limits<double>::quiet_NaN()), translation};
+        return {Eigen::Quaterniond(q.coeffs() / norm).toRotationMatrix(), translation};
+    }
 };
 
 }  // namespace hbvh

@@ -3,10 +3,13 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
+#include <stdexcept>
 #include <utility>
 #include <vector>
 
+#include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
@@ -26,6 +29,21 @@ struct CollideResult {
     std::uint64_t bv_tests = 0;         ///< Overlap tests in which at least one volume is an inner node's.
     std::uint64_t primitive_tests = 0;  ///< Overlap tests between two leaves (exact primitive geometry).
     std::uint64_t nodes_visited = 0;    ///< Node pairs found overlapping and then expanded or reported.
+    /// Set when the query was refused (a pose that is no rigid motion, or for the Bvh overloads a hierarchy
+    /// that fails check_structure()); the rest of the result is then empty. Poses made by
+    /// RigidTransform::from_quaternion from a non-zero quaternion are never refused.
+    std::optional<Error> error;
+};
+
+/// Thrown by QueryTree's constructor for a Bvh that fails check_structure(); QueryTree::create returns the
+/// same Error instead of throwing.
+class InvalidHierarchy : public std::invalid_argument {
+public:
+    explicit InvalidHierarchy(Error error) : std::invalid_argument(error.to_string()), error_(std::move(error)) {}
+    [[nodiscard]] const Error& error() const { return error_; }
+
+private:
+    Error error_;
 };
 
 /// One node of a QueryTree: the hot data of the traversal, 152 bytes. Same indices as the Bvh it came
@@ -48,8 +66,14 @@ struct QueryNode {
 /// can need.
 class QueryTree {
 public:
-    /// Converts `bvh`. An empty Bvh gives an empty tree, which collides with nothing.
+    /// Converts `bvh` after check_structure(bvh) (linear time): a malformed Bvh (child ranges past the end,
+    /// a non-breadth-first order, NaN or negative geometry, a box whose axes are no rotation) throws
+    /// InvalidHierarchy instead of being read out of bounds or pruned on. Whether volumes enclose their
+    /// primitives is validate()'s job (a full check is O(n log n)), run by every CLI command on stored files.
+    /// An empty Bvh gives an empty tree, which collides with nothing.
     explicit QueryTree(const Bvh& bvh);
+    /// As the constructor, returning the Error instead of throwing.
+    [[nodiscard]] static Result<QueryTree> create(const Bvh& bvh);
 
     /// True for a tree converted from an empty Bvh.
     [[nodiscard]] bool empty() const { return nodes_.empty(); }
@@ -63,6 +87,10 @@ public:
     [[nodiscard]] std::uint32_t stack_bound() const { return stack_bound_; }
 
 private:
+    struct Checked {};  // the Bvh passed check_structure()
+    static Checked checked_or_throw(const Bvh& bvh);
+    QueryTree(const Bvh& bvh, Checked);
+
     std::vector<QueryNode> nodes_;
     std::vector<BoundingVolume> volumes_;
     std::vector<std::uint32_t> primitive_nodes_;
@@ -80,6 +108,8 @@ private:
 /// each tree's model frame to the world. No allocation except growing `result.pairs` (and a heap stack
 /// when the two trees' stack bounds add up to more than the built-in 1024 entries).
 /// `result` is overwritten; reusing it across queries keeps the pairs' capacity.
+/// Each pose is checked once per query (validate_pose: finite, a proper rotation within 1e-9); a bad one
+/// sets result.error and nothing else.
 void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
              CollideMode mode, CollideResult& result);
 /// As above, returning a fresh result.

@@ -1,0 +1,33 @@
+// SPDX-License-Identifier: MIT
+// validation: the checks that stand between geometry from a program and the builders and queries.
+//
+// Every conservative test in hbvh assumes finite numbers, non-negative sizes and proper rotations; a NaN
+// centre makes every comparison false and silently prunes a subtree. So build(), QueryTree and collide()
+// refuse such input with an Error instead of computing on it (docs/bad-input.md).
+#pragma once
+
+#include <span>
+#include <string>
+
+#include "hbvh/geometry/primitive.hpp"
+#include "hbvh/result.hpp"
+
+namespace hbvh {
+
+/// Largest |R^T R - I| entry (and |det R - 1|) accepted for a rotation: a few thousand ulps, far more than
+/// composing a handful of rotations or normalising a quaternion loses, far less than any real shear.
+inline constexpr double rotation_tolerance = 1e-9;
+
+/// Empty when `rotation` is a proper rotation within rotation_tolerance; otherwise the problem in words.
+[[nodiscard]] std::string rotation_problem(const Mat3& rotation);
+/// Empty when `volume` is usable geometry; otherwise the problem in words ("radius -1 is negative", ...).
+/// Refused: non-finite numbers (also derived ones: a box's extent, a capsule's length), sizes < 0 and
+/// subnormal sizes (they vanish in the first product), rotations that are no proper rotation.
+/// Zero sizes are fine: a flat box, a point sphere, a capsule with p0 == p1 (a sphere).
+[[nodiscard]] std::string volume_problem(const BoundingVolume& volume);
+/// Ok, or an Error naming the first bad primitive: "primitive 3 ('leg'): radius -0.5 is negative".
+[[nodiscard]] Status validate_primitives(std::span<const Primitive> primitives);
+/// Ok, or an Error saying why `pose` is no rigid motion (non-finite numbers, no proper rotation).
+[[nodiscard]] Status validate_pose(const RigidTransform& pose);
+
+}  // namespace hbvh

@@ -1,0 +1,99 @@
+// SPDX-License-Identifier: MIT
+#include "hbvh/geometry/validation.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+namespace hbvh {
+namespace {
+
+std::string number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.17g", value);
+    return text;
+}
+
+/// Empty when `size` (a radius or half extent) is finite, >= 0 and not subnormal.
+std::string size_problem(const char* what, double size) {
+    if (!std::isfinite(size)) return std::string(what) + " is not a finite number";
+    if (size < 0.0) return std::string(what) + " " + number(size) + " is negative";
+    if (size > 0.0 && size < std::numeric_limits<double>::min())
+        return std::string(what) + " " + number(size) + " is subnormal (too small to compute with)";
+    return {};
+}
+
+std::string vector_problem(const char* what, const Vec3& v) {
+    return v.allFinite() ? std::string{} : std::string(what) + " is not finite";
+}
+
+/// The first non-empty problem of a list.
+template <class... Problems>
+std::string first_of(Problems&&... problems) {
+    std::string result;
+    ((result.empty() ? void(result = std::forward<Problems>(problems)) : void()), ...);
+    return result;
+}
+
+}  // namespace
+
+std::string rotation_problem(const Mat3& rotation) {
+    if (!rotation.allFinite()) return "rotation is not finite";
+    const double orthogonality = (rotation.transpose() * rotation - Mat3::Identity()).cwiseAbs().maxCoeff();
+    if (!(orthogonality <= rotation_tolerance))
+        return "rotation is not orthonormal: |R^T R - I| = " + number(orthogonality);
+    const double determinant = rotation.determinant();
+    if (!(std::abs(determinant - 1.0) <= rotation_tolerance))
+        return "rotation is a reflection (determinant " + number(determinant) + "), not a rotation";
+    return {};
+}
+
+std::string volume_problem(const BoundingVolume& volume) {
+    return std::visit(
+        Overloaded{
+            [](const Aabb& box) {
+                return first_of(vector_problem("min corner", box.min), vector_problem("max corner", box.max),
+                                vector_problem("extent (max - min)", Vec3(box.max - box.min)),
+                                size_problem("x extent (max - min)", box.max.x() - box.min.x()),
+                                size_problem("y extent (max - min)", box.max.y() - box.min.y()),
+                                size_problem("z extent (max - min)", box.max.z() - box.min.z()));
+            },
+            [](const Obb& box) {
+                return first_of(vector_problem("centre", box.center), rotation_problem(box.rotation),
+                                size_problem("x half extent", box.half_extents.x()),
+                                size_problem("y half extent", box.half_extents.y()),
+                                size_problem("z half extent", box.half_extents.z()),
+                                vector_problem("extent", Vec3(2.0 * box.half_extents)));
+            },
+            [](const Sphere& sphere) {
+                return first_of(vector_problem("centre", sphere.center), size_problem("radius", sphere.radius));
+            },
+            [](const Capsule& capsule) {
+                std::string length = std::isfinite(capsule.length()) && capsule.center().allFinite()
+                                         ? std::string{}
+                                         : "length or centre overflows the range of double";
+                return first_of(vector_problem("p0", capsule.p0), vector_problem("p1", capsule.p1),
+                                size_problem("radius", capsule.radius), std::move(length));
+            },
+        },
+        volume);
+}
+
+Status validate_primitives(std::span<const Primitive> primitives) {
+    for (std::size_t i = 0; i < primitives.size(); ++i) {
+        std::string problem = volume_problem(primitives[i].volume);
+        if (problem.empty()) continue;
+        std::string where = "primitive " + std::to_string(i);
+        if (!primitives[i].name.empty()) where += " ('" + primitives[i].name + "')";
+        return Error{where + " (" + std::string(to_string(type_of(primitives[i].volume))) + "): " + problem};
+    }
+    return Ok{};
+}
+
+Status validate_pose(const RigidTransform& pose) {
+    if (!pose.translation.allFinite()) return Error{"pose: translation is not finite"};
+    if (std::string problem = rotation_problem(pose.rotation); !problem.empty()) return Error{"pose: " + problem};
+    return Ok{};
+}
+
+}  // namespace hbvh

@@ -1,0 +1,156 @@
+// SPDX-License-Identifier: MIT
+// validate_primitives / validate_pose / from_quaternion: what the library refuses, and that build(),
+// QueryTree and collide() refuse it too instead of pruning on it.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "hbvh/build/build.hpp"
+#include "hbvh/geometry/validation.hpp"
+#include "hbvh/query/tandem_traversal.hpp"
+
+namespace hbvh {
+namespace {
+
+constexpr double nan = std::numeric_limits<double>::quiet_NaN();
+constexpr double inf = std::numeric_limits<double>::infinity();
+
+std::vector<Primitive> good_primitives() {
+    return {{Aabb{Vec3(0, 0, 0), Vec3(1, 1, 1)}, "box"},
+            {Sphere{Vec3(3, 0, 0), 0.5}, "ball"},
+            {Capsule{Vec3(0, 3, 0), Vec3(1, 3, 0), 0.25}, "rod"},
+            {Obb{Vec3(5, 5, 5), Eigen::AngleAxisd(0.3, Vec3::UnitZ()).toRotationMatrix(), Vec3(1, 2, 0.5)}, "crate"}};
+}
+
+/// The Error message of validate_primitives after replacing primitive 1 by `bad`.
+std::string refusal(BoundingVolume bad) {
+    std::vector<Primitive> primitives = good_primitives();
+    primitives[1] = {std::move(bad), "bad one"};
+    const Status status = validate_primitives(primitives);
+    return status ? std::string{} : status.error().message;
+}
+
+TEST(ValidatePrimitives, AcceptsGoodAndDegenerateButUsableGeometry) {
+    EXPECT_TRUE(validate_primitives(good_primitives()));
+    std::vector<Primitive> degenerate{{Aabb{Vec3(0, 0, 0), Vec3(1, 0, 1)}, "flat"},
+                                      {Sphere{Vec3(0, 0, 0), 0.0}, "point"},
+                                      {Capsule{Vec3(1, 1, 1), Vec3(1, 1, 1), 0.5}, "ball-like capsule"}};
+    EXPECT_TRUE(validate_primitives(degenerate));
+}
+
+TEST(ValidatePrimitives, NamesTheIndexNameAndProblem) {
+    const std::string message = refusal(Sphere{Vec3(0, 0, 0), -0.5});
+    EXPECT_NE(message.find("primitive 1 ('bad one')"), std::string::npos) << message;
+    EXPECT_NE(message.find("negative"), std::string::npos) << message;
+}
+
+TEST(ValidatePrimitives, RefusesEveryKindOfBadNumber) {
+    Mat3 shear = Mat3::Identity();
+    shear(0, 1) = 1e-6;
+    Mat3 mirror = Mat3::Identity();
+    mirror(2, 2) = -1.0;
+    const double denormal = std::numeric_limits<double>::denorm_min() * 4;
+    const std::vector<std::pair<BoundingVolume, const char*>> cases{
+        {Sphere{Vec3(nan, 0, 0), 1.0}, "not finite"},
+        {Sphere{Vec3(0, 0, 0), nan}, "not a finite number"},
+        {Sphere{Vec3(0, 0, 0), inf}, "not a finite number"},
+        {Sphere{Vec3(0, 0, 0), denormal}, "subnormal"},
+        {Capsule{Vec3(0, 0, 0), Vec3(1, 0, 0), -1.0}, "negative"},
+        {Capsule{Vec3(0, nan, 0), Vec3(1, 0, 0), 1.0}, "not finite"},
+        {Capsule{Vec3(-1e308, 0, 0), Vec3(1e308, 0, 0), 1.0}, "overflows"},
+        {Aabb{Vec3(0, 0, 0), Vec3(1, -1, 1)}, "negative"},
+        {Aabb{Vec3(0, 0, 0), Vec3(1, nan, 1)}, "not finite"},
+        {Aabb{Vec3(0, 0, 0), Vec3(1, denormal, 1)}, "subnormal"},
+        {Aabb{Vec3(-1e308, 0, 0), Vec3(1e308, 1, 1)}, "not finite"},
+        {Obb{Vec3(0, 0, 0), shear, Vec3(1, 1, 1)}, "not orthonormal"},
+        {Obb{Vec3(0, 0, 0), mirror, Vec3(1, 1, 1)}, "reflection"},
+        {Obb{Vec3(0, 0, 0), Mat3::Identity(), Vec3(1, -2, 1)}, "negative"},
+        {Obb{Vec3(0, 0, 0), Mat3::Constant(nan), Vec3(1, 1, 1)}, "not finite"},
+    };
+    for (const auto& [volume, expected] : cases) {
+        const std::string message = refusal(volume);
+        EXPECT_NE(message.find(expected), std::string::npos) << "expected '" << expected << "', got '" << message << "'";
+    }
+}
+
+TEST(ValidatePose, RefusesNonRigidMotions) {
+    EXPECT_TRUE(validate_pose(RigidTransform::identity()));
+    EXPECT_TRUE(validate_pose(RigidTransform::from_quaternion(0.92, 0.0, 0.38, 0.0, Vec3(1e5, 0, 0))));
+    RigidTransform scaled;
+    scaled.rotation *= 1.001;
+    EXPECT_FALSE(validate_pose(scaled));
+    RigidTransform mirrored;
+    mirrored.rotation(1, 1) = -1.0;
+    EXPECT_FALSE(validate_pose(mirrored));
+    RigidTransform nan_translation;
+    nan_translation.translation.x() = nan;
+    EXPECT_FALSE(validate_pose(nan_translation));
+    EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(0, 0, 0, 0)));
+    EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(nan, 0, 0, 1)));
+}
+
+TEST(FromQuaternion, NormalisesAndMatchesAnAxisAngleRotation) {
+    // A quaternion scaled by 7: the same rotation as the unit one, here 90 degrees about y.
+    const double h = std::sqrt(0.5);
+    const RigidTransform pose = RigidTransform::from_quaternion(7 * h, 0, 7 * h, 0, Vec3(1, 2, 3));
+    const Mat3 expected = Eigen::AngleAxisd(std::numbers::pi / 2, Vec3::UnitY()).toRotationMatrix();
+    EXPECT_LT((pose.rotation - expected).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_EQ(pose.translation, Vec3(1, 2, 3));
+    // x -> z maps under +90 degrees about y to -x: a hand-computed point.
+    EXPECT_LT((pose.apply(Vec3(0, 0, 1)) - Vec3(2, 2, 3)).norm(), 1e-15);
+}
+
+TEST(CheckFiniteExtent, RefusesNan) {
+    // Eigen's min/max may skip a NaN operand; the NaN must not vanish in the merged box.
+    std::vector<Primitive> primitives = good_primitives();
+    primitives.push_back({Sphere{Vec3(nan, 0, 0), 1.0}, "nan"});
+    const Status status = check_finite_extent(primitives);
+    ASSERT_FALSE(status);
+    EXPECT_NE(status.error().message.find("primitive 4"), std::string::npos) << status.error().message;
+}
+
+TEST(Build, RefusesBadGeometryNamingThePrimitive) {
+    std::vector<Primitive> primitives = good_primitives();
+    primitives[2] = {Sphere{Vec3(0, 0, 0), -1.0}, "negative"};
+    for (const AlgorithmInfo& info : algorithms()) {
+        const Result<Bvh> built = build(primitives, info.algorithm);
+        ASSERT_FALSE(built) << info.name;
+        EXPECT_NE(built.error().message.find("primitive 2 ('negative')"), std::string::npos) << built.error().message;
+    }
+}
+
+TEST(QueryTree, RefusesANanVolumeInsteadOfPruningOnIt) {
+    Bvh bvh = build(good_primitives(), Algorithm::split).value();
+    bvh.nodes[0].volume = Sphere{Vec3(nan, 0, 0), 1.0};
+    EXPECT_FALSE(QueryTree::create(bvh));
+    EXPECT_THROW(QueryTree{bvh}, InvalidHierarchy);
+    // The Bvh convenience overload reports it rather than answering "no contact".
+    const CollideResult result = collide(bvh, RigidTransform::identity(), bvh, RigidTransform::identity());
+    ASSERT_TRUE(result.error.has_value());
+    EXPECT_FALSE(result.intersecting);
+}
+
+TEST(Collide, RefusesAPoseThatIsNoRotation) {
+    const QueryTree tree(build(good_primitives(), Algorithm::split).value());
+    RigidTransform sheared;
+    sheared.rotation(0, 1) = 0.5;
+    for (const CollideMode mode : {CollideMode::all, CollideMode::first}) {
+        const CollideResult tandem = collide(tree, RigidTransform::identity(), tree, sheared, mode);
+        ASSERT_TRUE(tandem.error.has_value());
+        EXPECT_NE(tandem.error->message.find("pose_b"), std::string::npos) << tandem.error->message;
+        EXPECT_TRUE(tandem.pairs.empty());
+        const CollideResult two_level = collide_two_level(tree, sheared, tree, RigidTransform::identity(), mode);
+        ASSERT_TRUE(two_level.error.has_value());
+        EXPECT_NE(two_level.error->message.find("pose_a"), std::string::npos);
+    }
+    // The same query with a proper pose is answered, and the error is cleared on reuse.
+    CollideResult reused;
+    collide(tree, RigidTransform::identity(), tree, sheared, CollideMode::all, reused);
+    collide(tree, RigidTransform::identity(), tree, RigidTransform::identity(), CollideMode::all, reused);
+    EXPECT_FALSE(reused.error.has_value());
+    EXPECT_TRUE(reused.intersecting);
+}
+
+}  // namespace
+}  // namespace hbvh
