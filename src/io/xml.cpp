@@ -88,6 +88,7 @@ private:
         BoundingVolume volume;
         std::string name;
         std::vector<std::uint32_t> children;  ///< Indices of the child items, in document order.
+        std::ptrdiff_t offset = 0;            ///< The element's byte offset, for its line.
     };
 
     [[nodiscard]] int line_at(std::ptrdiff_t offset) const {
@@ -172,7 +173,7 @@ Result<XmlModel> Reader::run() {
         if (!detail::is_representable(*volume))
             return error(line_of(element), "volume's centre, length or extents overflow the range of double");
         const auto index = static_cast<std::uint32_t>(items.size());
-        items.push_back({std::move(volume).value(), std::move(name), {}});
+        items.push_back({std::move(volume).value(), std::move(name), {}, element.offset_debug()});
         if (parent != no_parent) items[parent].children.push_back(index);
 
         std::vector<pugi::xml_node> children;
@@ -211,7 +212,26 @@ Result<XmlModel> Reader::run() {
         for (std::uint32_t child : item.children) child_ids.push_back(id[child]);
         id[i] = assembler.add_group(child_ids, item.volume);
     }
-    model.hierarchy = std::move(assembler).finish(id[0]);
+    std::vector<std::uint32_t> assembler_id_of_node;
+    model.hierarchy = std::move(assembler).finish(id[0], &assembler_id_of_node);
+    // Every node's line in one pass over the text: item offsets grow in pre-order, so sorting the nodes by
+    // offset lets one forward scan count the newlines (line_at per node would be quadratic in big files).
+    std::vector<std::uint32_t> item_of_assembler_id(items.size());
+    for (std::uint32_t i = 0; i < items.size(); ++i) item_of_assembler_id[id[i]] = i;
+    std::vector<std::pair<std::ptrdiff_t, std::uint32_t>> offsets;  // (offset, node)
+    offsets.reserve(assembler_id_of_node.size());
+    for (std::uint32_t n = 0; n < assembler_id_of_node.size(); ++n)
+        offsets.emplace_back(items[item_of_assembler_id[assembler_id_of_node[n]]].offset, n);
+    std::sort(offsets.begin(), offsets.end());
+    model.node_lines.assign(offsets.size(), 0);
+    std::ptrdiff_t scanned = 0;
+    int line = 1;
+    for (const auto& [offset, node] : offsets) {
+        const std::ptrdiff_t end = std::clamp<std::ptrdiff_t>(offset, scanned, std::ssize(text_));
+        line += static_cast<int>(std::count(text_.begin() + scanned, text_.begin() + end, '\n'));
+        scanned = end;
+        model.node_lines[node] = line;
+    }
     return model;
 }
 

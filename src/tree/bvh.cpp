@@ -55,7 +55,7 @@ std::uint32_t TreeAssembler::add_group(std::span<const std::uint32_t> children, 
 
 void TreeAssembler::set_volume(std::uint32_t id, BoundingVolume volume) { items_.at(id).volume = std::move(volume); }
 
-Bvh TreeAssembler::finish(std::uint32_t root) && {
+Bvh TreeAssembler::finish(std::uint32_t root, std::vector<std::uint32_t>* id_of_node) && {
     // A group with one child adds a level without adding a choice: replace it by its child.
     auto skip_single = [&](std::uint32_t id) {
         while (items_[id].children.size() == 1) id = items_[id].children.front();
@@ -70,9 +70,11 @@ Bvh TreeAssembler::finish(std::uint32_t root) && {
     root = skip_single(root);
     bvh.nodes.push_back({items_[root].volume, 0, 0, items_[root].primitive});
     queue.emplace_back(root, 0);
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> placed;  // (item id, node index), for id_of_node
     while (!queue.empty()) {
         const auto [id, index] = queue.front();
         queue.pop_front();
+        if (id_of_node != nullptr) placed.emplace_back(id, index);
         const Item& item = items_[id];
         if (item.children.empty()) continue;
         bvh.nodes[index].first_child = static_cast<std::uint32_t>(bvh.nodes.size());
@@ -82,6 +84,10 @@ Bvh TreeAssembler::finish(std::uint32_t root) && {
             bvh.nodes.push_back({items_[real].volume, 0, 0, items_[real].primitive});
             queue.emplace_back(real, static_cast<std::uint32_t>(bvh.nodes.size() - 1));
         }
+    }
+    if (id_of_node != nullptr) {
+        id_of_node->resize(bvh.nodes.size());
+        for (const auto& [id, index] : placed) (*id_of_node)[index] = id;
     }
     return bvh;
 }

@@ -74,6 +74,7 @@ int run_build(const BuildArguments& args) {
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
+    if (Status stored = check_stored_hierarchy(model.value(), args.builder); !stored) return report_error(stored.error());
     Result<std::pair<Algorithm, BuildOptions>> resolved = args.builder.resolve();
     if (!resolved) {
         fmt::print(stderr, "hbvh build: {}\n", resolved.error().to_string());
@@ -109,6 +110,7 @@ void add_build_command(CLI::App& app, Command& command) {
     sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML), or - for stdout")->capture_default_str();
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     args->builder.add_to(*sub);
+    args->builder.add_refit_to(*sub);
     sub->add_flag("--report", args->report,
                   "Print the per-level build report to stderr, with the proven lower bound and gap when known");
     sub->add_flag("--stats", args->stats,

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "commands/command.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 
 namespace hbvh::cli {
@@ -40,13 +41,12 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
     }
     if (numbers.size() != 3 && numbers.size() != 7)
         return Error{std::string(flag) + " needs 3 numbers (translation) or 7 (translation, then quaternion w x y z)"};
-    RigidTransform pose;
-    pose.translation = Vec3(numbers[0], numbers[1], numbers[2]);
-    if (numbers.size() == 7) {
-        Eigen::Quaterniond q(numbers[3], numbers[4], numbers[5], numbers[6]);
-        if (q.norm() < 1e-12) return Error{std::string(flag) + ": the quaternion is zero"};
-        pose.rotation = q.normalized().toRotationMatrix();
-    }
+    const Vec3 translation(numbers[0], numbers[1], numbers[2]);
+    if (numbers.size() == 3) return RigidTransform{Mat3::Identity(), translation};
+    if (Eigen::Vector4d(numbers[3], numbers[4], numbers[5], numbers[6]).norm() < 1e-12)
+        return Error{std::string(flag) + ": the quaternion is zero"};
+    const RigidTransform pose = RigidTransform::from_quaternion(numbers[3], numbers[4], numbers[5], numbers[6], translation);
+    if (Status valid = validate_pose(pose); !valid) return Error{std::string(flag) + ": " + valid.error().message};
     return pose;
 }
 
@@ -69,6 +69,7 @@ int run_collide(const CollideArguments& args) {
 
     const CollideResult result = collide(bvh_a.value(), pose_a.value(), bvh_b.value(), pose_b.value(),
                                          args.first ? CollideMode::first : CollideMode::all);
+    if (result.error) return report_error(*result.error);
     if (args.json) {
         nlohmann::ordered_json pairs = nlohmann::ordered_json::array();
         for (const auto& [i, j] : result.pairs) pairs.push_back({i, j});
@@ -95,6 +96,7 @@ void add_collide_command(CLI::App& app, Command& command) {
     sub->add_option("--pose-a", args->pose_a, "Pose of a: \"tx ty tz [qw qx qy qz]\" (default identity)");
     sub->add_option("--pose-b", args->pose_b, "Pose of b");
     args->builder.add_to(*sub);
+    args->builder.add_refit_to(*sub);
     sub->add_flag("--first", args->first, "Stop at the first overlapping pair");
     sub->add_flag("--json", args->json, "Print {intersecting, pairs, bv_tests, primitive_tests}");
     sub->footer("Pairs are (primitive of a, primitive of b) in input order.\n"

@@ -12,6 +12,7 @@
 #include "hbvh/build/build.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
+#include "hbvh/tree/validate.hpp"
 
 namespace hbvh::cli {
 
@@ -39,6 +40,8 @@ struct Model {
     std::vector<Primitive> primitives;
     std::optional<Bvh> hierarchy;
     std::vector<std::string> warnings;
+    std::string source;           ///< The input's name in messages ("<stdin>" for "-").
+    std::vector<int> node_lines;  ///< With a hierarchy: each node's line in the file (XmlModel::node_lines).
 };
 
 /// Reads INPUT ("-" = stdin) in the format its extension says, or `format` when given.
@@ -58,12 +61,25 @@ struct BuilderFlags {
     double time_limit_seconds = 0.0;  ///< --time-limit: anytime builders return the best found by then.
     bool refine = false;              ///< --refine: treelet refinement after any builder.
     std::uint32_t treelet_units = TreeletOptions{}.max_units;  ///< --treelet-units.
+    bool refit = false;  ///< --refit: a stored hierarchy's non-enclosing volumes are refitted instead of refused.
     void add_to(CLI::App& command);
+    /// Adds --refit, for the commands that query or draw a stored hierarchy.
+    void add_refit_to(CLI::App& command);
     /// The algorithm and options, or a usage Error.
     [[nodiscard]] Result<std::pair<Algorithm, BuildOptions>> resolve() const;
 };
 
-/// The model's hierarchy, or one built from its primitives with `flags`.
+/// The model's stored hierarchy once it passes validate() (with flags.refit, its non-enclosing volumes
+/// refitted and a note printed), or one built from its primitives with `flags`. A stored hierarchy that
+/// fails is refused with "file:line: volume (obb) does not enclose primitive N ('name') by D".
 [[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags);
+/// Ok when the model has no stored hierarchy or its volumes enclose their primitives (or flags.refit, after
+/// a note); for build, which rebuilds from the primitives but must not pass over a broken file in silence.
+[[nodiscard]] Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags);
+/// One containment violation in words: "volume (obb) does not enclose primitive 3 ('leg') by 0.25"; the
+/// kind is the one read (an obb without orientation is an aabb).
+[[nodiscard]] std::string describe_violation(const Bvh& bvh, const ContainmentViolation& violation);
+/// The line of node `node` in the model's file, 0 when unknown.
+[[nodiscard]] int line_of_node(const Model& model, std::uint32_t node);
 
 }  // namespace hbvh::cli

@@ -8,10 +8,12 @@
 #include <iterator>
 
 #include "commands/command.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/import.hpp"
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/xml.hpp"
+#include "hbvh/tree/refit.hpp"
 
 namespace hbvh::cli {
 
@@ -55,7 +57,7 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
         if (path == "-" || chosen->second == ImportFormat::survey_xml || text.find("<mujoco") == std::string::npos) {
             Result<XmlModel> xml = read_xml_string(text, path == "-" ? "<stdin>" : path);
             if (!xml) return xml.error();
-            return Model{std::move(xml->primitives), std::move(xml->hierarchy), {}};
+            return Model{std::move(xml->primitives), std::move(xml->hierarchy), {}, {}, std::move(xml->node_lines)};
         }
     }
     Result<ImportResult> imported = import_primitives(path, chosen->second);
@@ -77,9 +79,13 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
 Result<Model> load_model(const std::string& path, const std::string& format) {
     Result<Model> model = read_model(path, format);
     if (!model) return model;
+    model->source = path == "-" ? "<stdin>" : path;
     // Refused here rather than in build() so that the message names the file.
-    if (Status finite = check_finite_extent(model->primitives); !finite)
-        return Error{finite.error().message, path == "-" ? "<stdin>" : path};
+    if (Status valid = validate_primitives(model->primitives); !valid) return Error{valid.error().message, model->source};
+    if (Status finite = check_finite_extent(model->primitives); !finite) return Error{finite.error().message, model->source};
+    if (model->hierarchy)
+        if (Status structure = check_structure(*model->hierarchy); !structure)
+            return Error{structure.error().message, model->source};
     return model;
 }
 
@@ -135,8 +141,53 @@ Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
     return std::pair{*chosen, options};
 }
 
+void BuilderFlags::add_refit_to(CLI::App& command) {
+    command.add_flag("--refit", refit,
+                     "A stored hierarchy whose volumes miss part of their primitives is repaired (each such volume "
+                     "refitted, same BV kind, tree kept) instead of refused");
+}
+
+int line_of_node(const Model& model, std::uint32_t node) {
+    return node < model.node_lines.size() ? model.node_lines[node] : 0;
+}
+
+std::string describe_violation(const Bvh& bvh, const ContainmentViolation& violation) {
+    const std::string& name = bvh.primitives[violation.primitive].name;
+    return fmt::format("volume ({}) does not enclose primitive {}{} by {:.3g}",
+                       to_string(type_of(bvh.nodes[violation.node].volume)), violation.primitive,
+                       name.empty() ? std::string{} : " ('" + name + "')", violation.protrusion);
+}
+
+namespace {
+/// The stored hierarchy if every volume encloses its primitives; with --refit, repaired; else the Error
+/// naming the first bad volume's line.
+Result<Bvh> checked_stored_hierarchy(const Model& model, const BuilderFlags& flags) {
+    const Bvh& stored = *model.hierarchy;
+    const std::vector<ContainmentViolation> violations = containment_violations(stored);
+    if (violations.empty()) return stored;
+    if (!flags.refit) {
+        std::string message = describe_violation(stored, violations.front());
+        if (violations.size() > 1) message += fmt::format(" (and {} more volumes)", violations.size() - 1);
+        return Error{message + "; --refit refits them", model.source, line_of_node(model, violations.front().node)};
+    }
+    Bvh repaired = stored;
+    const std::size_t refitted = refit_non_enclosing(repaired);
+    if (Status valid = validate(repaired); !valid) return Error{"after --refit: " + valid.error().message, model.source};
+    fmt::print(stderr, "hbvh: {}: refitted {} of {} volumes that did not enclose their primitives\n", model.source,
+               refitted, stored.nodes.size());
+    return repaired;
+}
+}  // namespace
+
+Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags) {
+    if (!model.hierarchy) return Ok{};
+    Result<Bvh> checked = checked_stored_hierarchy(model, flags);
+    if (!checked) return checked.error();
+    return Ok{};
+}
+
 Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags) {
-    if (model.hierarchy) return *model.hierarchy;
+    if (model.hierarchy) return checked_stored_hierarchy(model, flags);
     Result<std::pair<Algorithm, BuildOptions>> resolved = flags.resolve();
     if (!resolved) return resolved.error();
     return build(model.primitives, resolved->first, resolved->second);

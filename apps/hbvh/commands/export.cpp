@@ -125,6 +125,7 @@ void add_export_command(CLI::App& app, Command& command) {
         ->check(CLI::IsMember({"gltf", "dot", "svg"}));
     sub->add_option("--input-format", args->input_format, "Input format when the extension does not tell");
     args->builder.add_to(*sub);
+    args->builder.add_refit_to(*sub);
     sub->add_flag("--overlay", args->overlay, "glTF: put all levels at the same place instead of side by side");
     sub->add_flag("--no-carry", args->no_carry,
                   "DOT/SVG: draw each leaf under its parent, without grey copies down to the bottom row");

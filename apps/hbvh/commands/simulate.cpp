@@ -57,6 +57,7 @@ void add_simulate_command(CLI::App& app, Command& command) {
     CLI::App* sub = app.add_subcommand("simulate", "The survey's collision benchmark (§5.3, Table 4) on two copies of an object");
     sub->add_option("file", args->input, "A hierarchy or a primitive set")->required();
     args->builder.add_to(*sub);
+    args->builder.add_refit_to(*sub);
     sub->add_option("--collisions", args->options.collision_count, "Root-overlapping queries to measure")
         ->capture_default_str()
         ->check(CLI::Range(1u, 10000000u));

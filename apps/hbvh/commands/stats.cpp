@@ -50,17 +50,46 @@ void print_text(const Stats& stats) {
                stats.types[3]);
 }
 
+/// The stored hierarchy's containment violations, each with its line and message (`"violations"` in --json).
+nlohmann::ordered_json violations_json(const Model& model, const Bvh& bvh,
+                                       const std::vector<ContainmentViolation>& violations) {
+    nlohmann::ordered_json out = nlohmann::ordered_json::array();
+    for (const ContainmentViolation& v : violations)
+        out.push_back({{"node", v.node},
+                       {"line", line_of_node(model, v.node)},
+                       {"type", to_string(type_of(bvh.nodes[v.node].volume))},
+                       {"primitive", v.primitive},
+                       {"name", bvh.primitives[v.primitive].name},
+                       {"by", v.protrusion},
+                       {"message", describe_violation(bvh, v)}});
+    return out;
+}
+
 int run_stats(const StatsArguments& args) {
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
-    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    // A stored hierarchy is measured as it is, violations and all: stats is how a user checks a file.
+    Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : hierarchy_of(model.value(), args.builder);
     if (!bvh) return report_error(bvh.error());
+    const std::vector<ContainmentViolation> violations = containment_violations(bvh.value());
     const Stats stats = compute_stats(bvh.value());
-    if (args.json)
-        fmt::print("{}\n", to_json(stats).dump(2));
-    else
+    if (args.json) {
+        nlohmann::ordered_json out = to_json(stats);
+        out["violations"] = violations_json(model.value(), bvh.value(), violations);
+        fmt::print("{}\n", out.dump(2));
+    } else {
         print_text(stats);
+        if (violations.empty()) {
+            fmt::print("{:<12} none (every volume encloses its primitives)\n", "violations");
+        } else {
+            fmt::print("{:<12} {} volumes do not enclose their primitives (--refit on other commands repairs them)\n",
+                       "violations", violations.size());
+            for (const ContainmentViolation& v : violations)
+                fmt::print("  {}:{}: {}\n", model->source, line_of_node(model.value(), v.node),
+                           describe_violation(bvh.value(), v));
+        }
+    }
     return exit_ok;
 }
 }  // namespace

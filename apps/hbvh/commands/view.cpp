@@ -40,6 +40,7 @@ void add_view_command(CLI::App& app, Command& command) {
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     sub->add_option("--title", args->title, "Page title (default: the input's file name)");
     args->builder.add_to(*sub);
+    args->builder.add_refit_to(*sub);
     sub->footer("Example: hbvh view data/models/chair.xml -o chair.html, then open chair.html#level=2\n"
                 "See docs/export.md.");
     sub->callback([&command, args] { command = [args] { return run_view(*args); }; });

@@ -25,6 +25,9 @@ struct XmlModel {
     /// that child (the child's volume is kept). The reader does not check that volumes enclose their
     /// children: run validate() for that.
     std::optional<Bvh> hierarchy;
+    /// For a hierarchy: the 1-based line of the <volume> element each node's volume comes from, by node
+    /// index, so that a check of the tree (containment_violations) can name the line to fix.
+    std::vector<int> node_lines;
 };
 
 /// Largest |(M^T M - I)_ij| for which an `orientation` matrix M is accepted and replaced by the nearest

@@ -52,8 +52,9 @@ public:
     std::uint32_t add_group(std::span<const std::uint32_t> children, BoundingVolume volume);
     /// Replace the BV of group `id` (e.g. after refitting).
     void set_volume(std::uint32_t id, BoundingVolume volume);
-    /// The finished hierarchy rooted at `root`.
-    [[nodiscard]] Bvh finish(std::uint32_t root) &&;
+    /// The finished hierarchy rooted at `root`. When `id_of_node` is given it receives, for each node, the id
+    /// whose volume that node carries (after single-child groups are collapsed into their child).
+    [[nodiscard]] Bvh finish(std::uint32_t root, std::vector<std::uint32_t>* id_of_node = nullptr) &&;
 
 private:
     struct Item {
