@@ -34,7 +34,9 @@ Bvh two_pairs() {
 std::string structure_problem(const Bvh& bvh) {
     const Status status = check_structure(bvh);
     EXPECT_EQ(status.has_value(), QueryTree::create(bvh).has_value());
-    if (!status) EXPECT_FALSE(validate(bvh));  // validate() checks the structure first, and safely
+    if (!status) {
+        EXPECT_FALSE(validate(bvh));  // validate() checks the structure first, and safely
+    }
     return status ? std::string{} : status.error().message;
 }
 

@@ -30,7 +30,7 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
         options.one_primitive_per_mesh = true;
         Result<ImportResult> imported = import_mesh(path, options);
         if (!imported) return imported.error();
-        return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
+        return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings), {}, {}};
     }
     // The survey format keeps a stored hierarchy; the importers give primitives only.
     static const std::pair<const char*, ImportFormat> formats[] = {
@@ -72,7 +72,7 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
         if (skipped.size() > shown) message += "; and " + std::to_string(skipped.size() - shown) + " more";
         return Error{message, path};
     }
-    return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings)};
+    return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings), {}, {}};
 }
 }  // namespace
 
