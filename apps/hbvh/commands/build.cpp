@@ -10,7 +10,9 @@
 #include <string>
 
 #include "commands/command.hpp"
+#include "hbvh/io/file.hpp"
 #include "hbvh/io/xml.hpp"
+#include "hbvh/tree/binary_format.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh::cli {
@@ -98,7 +100,10 @@ int run_build(const BuildArguments& args) {
                        stats.leaves, stats.nodes, stats.height, stats.cost, to_string(algorithm), 1e3 * seconds,
                        bound_summary(report, stats.cost));
     }
-    if (Status written = write_output(args.output, write_xml(bvh.value())); !written) return report_error(written.error());
+    // -o NAME.hbvh writes the binary format, anything else the survey XML.
+    const bool binary = lower_case_extension(args.output) == ".hbvh";
+    const std::string content = binary ? write_binary(bvh.value()) : write_xml(bvh.value());
+    if (Status written = write_output(args.output, content); !written) return report_error(written.error());
     return exit_ok;
 }
 }  // namespace
@@ -107,7 +112,7 @@ void add_build_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<BuildArguments>();
     CLI::App* sub = app.add_subcommand("build", "Build a hierarchy over a set of primitives");
     sub->add_option("input", args->input, "Primitive file (survey XML, MJCF, URDF, mesh), or - for stdin")->required();
-    sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML), or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML; .hbvh: binary), or - for stdout")->capture_default_str();
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);

@@ -13,6 +13,7 @@
 #include "hbvh/io/import.hpp"
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/xml.hpp"
+#include "hbvh/tree/binary_format.hpp"
 #include "hbvh/tree/refit.hpp"
 
 namespace hbvh::cli {
@@ -42,7 +43,9 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
         return Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)", path};
 
     const std::string extension = std::filesystem::path(path).extension().string();
-    const bool maybe_survey = path == "-" || chosen->second == ImportFormat::survey_xml ||
+    // A .hbvh name, or (stdin, .xml) the binary format's magic bytes: docs/formats.md, "The binary format".
+    const bool binary_name = chosen->second == ImportFormat::automatic && lower_case_extension(path) == ".hbvh";
+    const bool maybe_survey = binary_name || path == "-" || chosen->second == ImportFormat::survey_xml ||
                               (chosen->second == ImportFormat::automatic && extension == ".xml");
     if (maybe_survey) {
         std::string text;
@@ -52,6 +55,14 @@ Result<Model> read_model(const std::string& path, const std::string& format) {
             Result<std::string> file = read_text_file(path);
             if (!file) return file.error();
             text = std::move(file.value());
+        }
+        if (binary_name || has_binary_magic(std::as_bytes(std::span(text)))) {
+            Result<Bvh> bvh = read_binary(std::as_bytes(std::span(text)), path == "-" ? "<stdin>" : path);
+            if (!bvh) return bvh.error();
+            std::vector<Primitive> primitives = bvh->primitives;
+            std::optional<Bvh> hierarchy;  // none for a primitive set (node count 0)
+            if (!bvh->nodes.empty()) hierarchy = std::move(bvh.value());
+            return Model{std::move(primitives), std::move(hierarchy), {}, {}, {}};
         }
         // An .xml whose root is <mujoco> is MJCF: hand it to the importer below.
         if (path == "-" || chosen->second == ImportFormat::survey_xml || text.find("<mujoco") == std::string::npos) {

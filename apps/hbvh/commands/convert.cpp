@@ -1,7 +1,9 @@
 // SPDX-License-Identifier: MIT
 // `hbvh convert`: MJCF, URDF or a mesh in, the survey's primitive XML out.
 #include "commands/command.hpp"
+#include "hbvh/io/file.hpp"
 #include "hbvh/io/xml.hpp"
+#include "hbvh/tree/binary_format.hpp"
 
 namespace hbvh::cli {
 
@@ -14,7 +16,7 @@ void add_convert_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<ConvertArguments>();
     CLI::App* sub = app.add_subcommand("convert", "Convert MJCF, URDF or a mesh (UBX_/USP_/UCP_/UCX_) to survey XML");
     sub->add_option("input", args->input, "Input file (.xml MJCF or survey, .urdf, .gltf/.glb/.obj/.fbx/.dae)")->required();
-    sub->add_option("-o,--output", args->output, "Output survey XML, or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", args->output, "Output survey XML (.hbvh: binary), or - for stdout")->capture_default_str();
     sub->add_option("--format", args->format, "xml, mjcf, urdf or mesh, when the extension does not tell; mesh-nodes: a plain mesh, one fitted primitive per mesh node");
     sub->footer("Example: hbvh convert robot.urdf -o robot.xml");
     sub->callback([&command, args] {
@@ -22,8 +24,13 @@ void add_convert_command(CLI::App& app, Command& command) {
             Result<Model> model = load_model(args->input, args->format);
             if (!model) return report_error(model.error());
             report_warnings(model->warnings);
-            const std::string xml = model->hierarchy ? write_xml(*model->hierarchy) : write_primitives_xml(model->primitives);
-            if (Status written = write_output(args->output, xml); !written) return report_error(written.error());
+            // -o NAME.hbvh writes the binary format (a primitive set as a Bvh without nodes), anything else XML.
+            std::string content;
+            if (lower_case_extension(args->output) == ".hbvh")
+                content = write_binary(model->hierarchy ? *model->hierarchy : Bvh{{}, model->primitives});
+            else
+                content = model->hierarchy ? write_xml(*model->hierarchy) : write_primitives_xml(model->primitives);
+            if (Status written = write_output(args->output, content); !written) return report_error(written.error());
             return exit_ok;
         };
     });

@@ -1,0 +1,131 @@
+// SPDX-License-Identifier: MIT
+// Loading a stored hierarchy at start-up: the .hbvh binary format against the survey XML, same tree, same disk.
+// The files are written once to a temporary directory (outside the timings, removed at exit); each timed
+// iteration reads one from disk and parses it completely (the binary reader also checks the CRC-64 and runs
+// check_structure, the XML reader does neither). Counter speedup_vs_xml on the binary row: XML time / binary time.
+//
+//   hbvh_bench --benchmark_filter='load_.*/20k'   (a split tree over 20 000 primitives, a second)
+//   hbvh_bench --benchmark_filter='load_.*/1M'    (a two-level tree over 10^6 primitives; the XML takes seconds)
+#include <benchmark/benchmark.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <string>
+
+#include "hbvh/builders/build.hpp"
+#include "hbvh/io/file.hpp"
+#include "hbvh/io/xml.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/binary_format.hpp"
+
+namespace hbvh::bench {
+void fail(benchmark::State& state, const std::string& message);
+
+namespace {
+
+/// One tree in both formats on disk.
+struct StoredTree {
+    std::filesystem::path xml;
+    std::filesystem::path binary;
+    std::size_t primitives = 0;
+    std::size_t nodes = 0;
+    std::size_t binary_bytes = 0;
+    std::size_t xml_bytes = 0;
+};
+
+/// The temporary directory and the files in it, made once per size; removed when the program ends.
+class StoredTrees {
+public:
+    ~StoredTrees() {
+        std::error_code ignored;
+        if (!dir_.empty()) std::filesystem::remove_all(dir_, ignored);
+    }
+    /// The files for `count` primitives, or an Error if building or writing failed.
+    Result<StoredTree> get(std::uint32_t count) {
+        if (const auto found = trees_.find(count); found != trees_.end()) return found->second;
+        if (dir_.empty()) {
+            dir_ = std::filesystem::temp_directory_path() / ("hbvh_bench_load_" + std::to_string(::getpid()));
+            std::filesystem::create_directories(dir_);
+        }
+        SceneOptions options;
+        options.count = count;
+        options.seed = 2024;
+        const std::vector<Primitive> primitives = generate_scene(options);
+        // split is the realistic tree but needs minutes at 10^6; two-level is built in well under a second.
+        Result<Bvh> bvh = build(primitives, count <= 20'000 ? Algorithm::split : Algorithm::two_level);
+        if (!bvh) return bvh.error();
+        StoredTree tree;
+        tree.xml = dir_ / (std::to_string(count) + ".xml");
+        tree.binary = dir_ / (std::to_string(count) + ".hbvh");
+        const std::string xml = write_xml(bvh.value());
+        if (Status written = write_file_atomic(tree.xml, xml); !written) return written.error();
+        if (Status written = write_binary_file(tree.binary, bvh.value()); !written) return written.error();
+        tree.primitives = bvh->primitives.size();
+        tree.nodes = bvh->nodes.size();
+        tree.xml_bytes = xml.size();
+        tree.binary_bytes = std::filesystem::file_size(tree.binary);
+        trees_.emplace(count, tree);
+        return tree;
+    }
+
+private:
+    std::filesystem::path dir_;
+    std::map<std::uint32_t, StoredTree> trees_;
+};
+
+StoredTrees& stored_trees() {
+    static StoredTrees trees;
+    return trees;
+}
+
+/// Seconds per XML load, per size, for the binary row's ratio (the XML row runs first).
+std::map<std::uint32_t, double>& xml_seconds() {
+    static std::map<std::uint32_t, double> seconds;
+    return seconds;
+}
+
+void load_xml(benchmark::State& state, std::uint32_t count) {
+    Result<StoredTree> tree = stored_trees().get(count);
+    if (!tree) return fail(state, tree.error().to_string());
+    std::size_t loaded_nodes = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) {
+        Result<XmlModel> model = read_xml_file(tree->xml);
+        loaded_nodes = model && model->hierarchy ? model->hierarchy->nodes.size() : 0;
+        benchmark::DoNotOptimize(loaded_nodes);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (loaded_nodes != tree->nodes) return fail(state, "the XML file did not load back as the tree written");
+    xml_seconds()[count] = seconds / static_cast<double>(state.iterations());
+    state.counters["primitives"] = static_cast<double>(tree->primitives);
+    state.counters["MB"] = static_cast<double>(tree->xml_bytes) / 1e6;
+}
+
+void load_binary(benchmark::State& state, std::uint32_t count) {
+    Result<StoredTree> tree = stored_trees().get(count);
+    if (!tree) return fail(state, tree.error().to_string());
+    std::size_t loaded_nodes = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) {
+        Result<Bvh> bvh = read_binary_file(tree->binary);
+        loaded_nodes = bvh ? bvh->nodes.size() : 0;
+        benchmark::DoNotOptimize(loaded_nodes);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (loaded_nodes != tree->nodes) return fail(state, "the .hbvh file did not load back as the tree written");
+    state.counters["primitives"] = static_cast<double>(tree->primitives);
+    state.counters["MB"] = static_cast<double>(tree->binary_bytes) / 1e6;
+    if (const auto xml = xml_seconds().find(count); xml != xml_seconds().end())
+        state.counters["speedup_vs_xml"] = xml->second / (seconds / static_cast<double>(state.iterations()));
+}
+
+BENCHMARK_CAPTURE(load_xml, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK_CAPTURE(load_binary, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(20);
+BENCHMARK_CAPTURE(load_xml, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(2);
+BENCHMARK_CAPTURE(load_binary, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
+
+}  // namespace
+}  // namespace hbvh::bench

@@ -1,0 +1,330 @@
+// SPDX-License-Identifier: MIT
+// The .hbvh binary format: round trips of trees from several builders, names in UTF-8, primitive sets and
+// single leaves; every truncation and every single-byte corruption refused; recomputed checksums leave only
+// valid trees; versions, magic, counts and the file helpers.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstring>
+#include <filesystem>
+#include <iterator>
+#include <limits>
+
+#include "hbvh/builders/build.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/binary_format.hpp"
+#include "hbvh/tree/validate.hpp"
+
+namespace hbvh {
+namespace {
+
+std::span<const std::byte> as_span(const std::string& bytes) { return std::as_bytes(std::span(bytes)); }
+
+Result<Bvh> read(const std::string& bytes) { return read_binary(as_span(bytes), "test.hbvh"); }
+
+std::uint64_t load_u64(const std::string& bytes, std::size_t at) {
+    std::uint64_t value = 0;
+    for (int i = 7; i >= 0; --i) value = (value << 8) | static_cast<unsigned char>(bytes[at + static_cast<std::size_t>(i)]);
+    return value;
+}
+void store_u64(std::string& bytes, std::size_t at, std::uint64_t value) {
+    for (std::size_t i = 0; i < 8; ++i) bytes[at + i] = static_cast<char>(value >> (8 * i));
+}
+/// Recomputes the trailing CRC-64 after an edit, so the edit reaches the checks behind the checksum.
+void reseal(std::string& bytes) {
+    const std::size_t at = bytes.size() - 8;
+    store_u64(bytes, at, crc64_xz(as_span(bytes).first(at)));
+}
+
+bool same_volume(const BoundingVolume& a, const BoundingVolume& b) {
+    if (a.index() != b.index()) return false;
+    return std::visit(Overloaded{[&](const Aabb& x) {
+                                     const auto& y = std::get<Aabb>(b);
+                                     return x.min == y.min && x.max == y.max;
+                                 },
+                                 [&](const Obb& x) {
+                                     const auto& y = std::get<Obb>(b);
+                                     return x.center == y.center && x.rotation == y.rotation &&
+                                            x.half_extents == y.half_extents;
+                                 },
+                                 [&](const Sphere& x) {
+                                     const auto& y = std::get<Sphere>(b);
+                                     return x.center == y.center && x.radius == y.radius;
+                                 },
+                                 [&](const Capsule& x) {
+                                     const auto& y = std::get<Capsule>(b);
+                                     return x.p0 == y.p0 && x.p1 == y.p1 && x.radius == y.radius;
+                                 }},
+                      a);
+}
+
+void expect_same(const Bvh& a, const Bvh& b) {
+    ASSERT_EQ(a.nodes.size(), b.nodes.size());
+    ASSERT_EQ(a.primitives.size(), b.primitives.size());
+    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+        EXPECT_TRUE(same_volume(a.nodes[i].volume, b.nodes[i].volume)) << "node " << i;
+        EXPECT_EQ(a.nodes[i].first_child, b.nodes[i].first_child) << "node " << i;
+        EXPECT_EQ(a.nodes[i].child_count, b.nodes[i].child_count) << "node " << i;
+        EXPECT_EQ(a.nodes[i].primitive, b.nodes[i].primitive) << "node " << i;
+    }
+    for (std::size_t i = 0; i < a.primitives.size(); ++i) {
+        EXPECT_TRUE(same_volume(a.primitives[i].volume, b.primitives[i].volume)) << "primitive " << i;
+        EXPECT_EQ(a.primitives[i].name, b.primitives[i].name) << "primitive " << i;
+    }
+}
+
+std::vector<Primitive> named_scene(std::uint32_t count, std::uint64_t seed) {
+    SceneOptions options;
+    options.count = count;
+    options.seed = seed;
+    std::vector<Primitive> primitives = generate_scene(options);
+    // Names in several scripts and lengths, one empty.
+    const char* names[] = {"seat", "", "Stuhlbein-ä", "椅子の脚", "🪑 knob", "x"};
+    for (std::size_t i = 0; i < primitives.size(); ++i) primitives[i].name = names[i % std::size(names)];
+    return primitives;
+}
+
+Bvh built(const std::vector<Primitive>& primitives, Algorithm algorithm) {
+    Result<Bvh> bvh = build(primitives, algorithm);
+    EXPECT_TRUE(bvh.has_value()) << (bvh ? "" : bvh.error().to_string());
+    return bvh ? std::move(bvh).value() : Bvh{};
+}
+
+/// Four spheres under an OBB root and a capsule group: all four kinds, small enough to corrupt byte by byte.
+Bvh small_tree() {
+    Bvh bvh;
+    for (int i = 0; i < 4; ++i)
+        bvh.primitives.push_back({Sphere{Vec3(2.0 * i, 0, 0), 0.5}, i == 2 ? "ä" : "s" + std::to_string(i)});
+    bvh.nodes.push_back({Obb{Vec3(3, 0, 0), Mat3::Identity(), Vec3(4, 1, 1)}, 1, 2, 0});
+    bvh.nodes.push_back({Aabb{Vec3(-1, -1, -1), Vec3(3, 1, 1)}, 3, 2, 0});
+    bvh.nodes.push_back({Capsule{Vec3(4, 0, 0), Vec3(6, 0, 0), 1.0}, 5, 2, 0});
+    for (std::uint32_t i = 0; i < 4; ++i) bvh.nodes.push_back({bvh.primitives[i].volume, 0, 0, i});
+    return bvh;
+}
+
+TEST(BinaryFormat, Crc64MatchesTheStandardCheckValue) {
+    const std::string check = "123456789";
+    EXPECT_EQ(crc64_xz(as_span(check)), 0x995DC9BBDF1939FAULL);
+    EXPECT_EQ(crc64_xz({}), 0u);
+    // The 8-byte loop and the byte tail agree: every split of the same bytes gives one CRC (a longer input).
+    const std::string longer = "The quick brown fox jumps over the lazy dog";
+    EXPECT_EQ(crc64_xz(as_span(longer)), 0x5B5EB8C2E54AA1C4ULL);
+}
+
+TEST(BinaryFormat, LayoutIsLittleEndianFieldByField) {
+    Bvh set;
+    set.primitives.push_back({Sphere{Vec3(1, 2, 3), 0.5}, "a"});
+    const std::string bytes = write_binary(set);
+    // header 40 + sphere record (1 + 4 x 8) + name (4 + 1) + checksum 8
+    ASSERT_EQ(bytes.size(), 40u + 33u + 5u + 8u);
+    EXPECT_EQ(std::memcmp(bytes.data(), binary_magic.data(), 8), 0);
+    EXPECT_EQ(bytes.substr(8, 4), std::string("\x01\x00\x00\x00", 4));  // version 1
+    EXPECT_EQ(bytes.substr(12, 4), std::string(4, '\0'));                // flags
+    EXPECT_EQ(load_u64(bytes, 16), bytes.size());                         // file size
+    EXPECT_EQ(load_u64(bytes, 24), 0u);                                   // nodes: a primitive set
+    EXPECT_EQ(load_u64(bytes, 32), 1u);                                   // primitives
+    EXPECT_EQ(bytes[40], 2);                                              // kind: sphere
+    EXPECT_EQ(bytes.substr(41, 8), std::string("\x00\x00\x00\x00\x00\x00\xf0\x3f", 8));  // 1.0
+    EXPECT_EQ(load_u64(bytes, 41 + 24), std::bit_cast<std::uint64_t>(0.5));
+    EXPECT_EQ(bytes.substr(73, 5), std::string("\x01\x00\x00\x00" "a", 5));
+    EXPECT_EQ(load_u64(bytes, 78), crc64_xz(as_span(bytes).first(78)));
+}
+
+TEST(BinaryFormat, TreesFromSeveralBuildersRoundTrip) {
+    const std::vector<Primitive> primitives = named_scene(60, 11);
+    for (Algorithm algorithm : {Algorithm::two_level, Algorithm::split, Algorithm::merge, Algorithm::insertion,
+                                Algorithm::obb_tree, Algorithm::insertion_haber}) {
+        SCOPED_TRACE(std::string(to_string(algorithm)));
+        const Bvh original = built(primitives, algorithm);
+        const std::string bytes = write_binary(original);
+        Result<Bvh> back = read(bytes);
+        ASSERT_TRUE(back.has_value()) << back.error().to_string();
+        expect_same(original, back.value());
+        EXPECT_EQ(write_binary(back.value()), bytes);  // canonical
+        EXPECT_TRUE(validate(back.value()));
+    }
+}
+
+TEST(BinaryFormat, SingleLeafAndPrimitiveSetRoundTrip) {
+    Bvh leaf;
+    leaf.primitives.push_back({Capsule{Vec3(0, 0, 0), Vec3(0, 0, 1), 0.25}, "only"});
+    leaf.nodes.push_back({leaf.primitives[0].volume, 0, 0, 0});
+    Result<Bvh> back = read(write_binary(leaf));
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    expect_same(leaf, back.value());
+
+    Bvh set;
+    set.primitives = named_scene(7, 3);
+    back = read(write_binary(set));
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    EXPECT_TRUE(back->nodes.empty());
+    expect_same(set, back.value());
+}
+
+TEST(BinaryFormat, NamesMustBeUtf8WithoutNul) {
+    for (const std::string& bad : {std::string("\xff"), std::string("ab\xc3"), std::string("\xc0\x80"),
+                                  std::string("\xed\xa0\x80"), std::string("a\0b", 3), std::string("\xf4\x90\x80\x80")}) {
+        Bvh set;
+        set.primitives.push_back({Sphere{Vec3(0, 0, 0), 1.0}, bad});
+        Result<Bvh> back = read(write_binary(set));
+        ASSERT_FALSE(back.has_value()) << "accepted a bad name";
+        EXPECT_TRUE(back.error().message.find("NUL") != std::string::npos ||
+                    back.error().message.find("not UTF-8") != std::string::npos)
+            << back.error().message;
+    }
+}
+
+TEST(BinaryFormat, EveryTruncationIsRefused) {
+    const std::string bytes = write_binary(small_tree());
+    ASSERT_TRUE(read(bytes).has_value());
+    for (std::size_t length = 0; length < bytes.size(); ++length) {
+        Result<Bvh> back = read(bytes.substr(0, length));
+        ASSERT_FALSE(back.has_value()) << "accepted the first " << length << " bytes";
+        EXPECT_EQ(back.error().file, "test.hbvh");
+        EXPECT_EQ(back.error().line, 0);
+        EXPECT_EQ(back.error().message.rfind("offset ", 0), 0u) << back.error().message;
+        if (length > 0) {
+            EXPECT_NE(back.error().message.find("truncated"), std::string::npos) << back.error().message;
+        }
+    }
+}
+
+TEST(BinaryFormat, EverySingleByteCorruptionIsRefused) {
+    const std::string bytes = write_binary(small_tree());
+    for (std::size_t at = 0; at < bytes.size(); ++at)
+        for (unsigned flip : {0x01u, 0x80u, 0xFFu}) {
+            std::string corrupted = bytes;
+            corrupted[at] = static_cast<char>(static_cast<unsigned char>(corrupted[at]) ^ flip);
+            Result<Bvh> back = read(corrupted);
+            ASSERT_FALSE(back.has_value()) << "byte " << at << " ^ " << flip << " accepted";
+            // Past the header's fields that are checked first, it is the checksum that notices.
+            if (at >= 24) {
+                EXPECT_NE(back.error().message.find("checksum mismatch"), std::string::npos) << back.error().message;
+            }
+        }
+}
+
+TEST(BinaryFormat, ResealedCorruptionGivesAnErrorOrAValidTree) {
+    const std::string bytes = write_binary(small_tree());
+    std::size_t accepted = 0, refused = 0;
+    for (std::size_t at = 0; at + 8 < bytes.size(); ++at)
+        for (unsigned flip : {0x01u, 0x10u, 0x80u, 0xFFu}) {
+            std::string corrupted = bytes;
+            corrupted[at] = static_cast<char>(static_cast<unsigned char>(corrupted[at]) ^ flip);
+            reseal(corrupted);
+            Result<Bvh> back = read(corrupted);
+            if (!back) {
+                ++refused;
+                EXPECT_EQ(back.error().message.find("checksum"), std::string::npos) << back.error().message;
+                continue;
+            }
+            ++accepted;
+            // Accepted only as a sound tree, which is exactly what the bytes say.
+            EXPECT_TRUE(check_structure(back.value())) << "byte " << at;
+            EXPECT_EQ(write_binary(back.value()), corrupted) << "byte " << at;
+        }
+    // Both happen: a low mantissa bit of a coordinate is still a tree, a child count of 3 is not.
+    EXPECT_GT(accepted, 0u);
+    EXPECT_GT(refused, 0u);
+}
+
+TEST(BinaryFormat, MalformedTreesAndBadGeometryBehindAGoodChecksumAreRefused) {
+    Bvh single_child = small_tree();
+    single_child.nodes[2].child_count = 1;
+    Result<Bvh> back = read(write_binary(single_child));
+    ASSERT_FALSE(back.has_value());
+    // Node 2's record: header 40 + node 0 (OBB: 1 + 15 x 8 + 12) + node 1 (AABB: 1 + 6 x 8 + 12).
+    EXPECT_EQ(back.error().message, "offset " + std::to_string(40 + 133 + 61) + ": node 2: inner node with a single child");
+
+    Bvh nan_node = small_tree();
+    std::get<Aabb>(nan_node.nodes[1].volume).max.x() = std::numeric_limits<double>::quiet_NaN();
+    back = read(write_binary(nan_node));
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset 173: node 1:", 0), 0u) << back.error().message;
+
+    Bvh negative = small_tree();
+    negative.nodes.clear();
+    std::get<Sphere>(negative.primitives[3].volume).radius = -1.0;
+    back = read(write_binary(negative));
+    ASSERT_FALSE(back.has_value());
+    // The fourth sphere record of the primitive set: 40 + 3 x 33.
+    EXPECT_EQ(back.error().message.rfind("offset 139: primitive 3", 0), 0u) << back.error().message;
+
+    Bvh shared_leaf = small_tree();
+    shared_leaf.nodes[6].primitive = 0;
+    EXPECT_FALSE(read(write_binary(shared_leaf)).has_value());
+
+    std::string unknown_kind = write_binary(small_tree());
+    unknown_kind[40] = 9;
+    reseal(unknown_kind);
+    back = read(unknown_kind);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset 40: unknown volume kind 9", 0), 0u) << back.error().message;
+}
+
+TEST(BinaryFormat, OtherVersionsMagicAndTrailingBytesAreRefused) {
+    std::string bytes = write_binary(small_tree());
+    std::string newer = bytes;
+    newer[8] = 2;
+    reseal(newer);
+    Result<Bvh> back = read(newer);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message, "offset 8: format version 2 is not supported (this reader reads version 1)");
+
+    back = read("<?xml version=\"1.0\"?><hierarchy/>");
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message, "offset 0: not an .hbvh file (wrong magic bytes)");
+
+    back = read(bytes + "xx");
+    ASSERT_FALSE(back.has_value());
+    EXPECT_NE(back.error().message.find("2 bytes after the end"), std::string::npos) << back.error().message;
+
+    back = read(write_binary(Bvh{}));
+    ASSERT_FALSE(back.has_value());
+    EXPECT_NE(back.error().message.find("no primitives"), std::string::npos) << back.error().message;
+}
+
+TEST(BinaryFormat, HugeCountsAreRefusedBeforeAllocating) {
+    const std::string bytes = write_binary(small_tree());
+    for (std::uint64_t count : {std::uint64_t{1} << 40, std::uint64_t{UINT32_MAX}, std::uint64_t{14}, ~std::uint64_t{0}}) {
+        std::string nodes = bytes;
+        store_u64(nodes, 24, count);
+        reseal(nodes);
+        Result<Bvh> back = read(nodes);
+        ASSERT_FALSE(back.has_value()) << count;
+        EXPECT_EQ(back.error().message.rfind("offset 24: node count", 0), 0u) << back.error().message;
+
+        std::string primitives = bytes;
+        store_u64(primitives, 32, count);
+        reseal(primitives);
+        back = read(primitives);
+        ASSERT_FALSE(back.has_value()) << count;
+        EXPECT_EQ(back.error().message.rfind("offset 32: primitive count", 0), 0u) << back.error().message;
+    }
+}
+
+TEST(BinaryFormat, FileHelpersWriteAtomicallyAndNameTheFile) {
+    const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "hbvh_binary_format_test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const Bvh original = built(named_scene(30, 5), Algorithm::split);
+    const std::filesystem::path file = dir / "tree.hbvh";
+    ASSERT_TRUE(write_binary_file(file, original));
+    ASSERT_TRUE(write_binary_file(file, original));  // over an existing file
+    Result<Bvh> back = read_binary_file(file);
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    expect_same(original, back.value());
+    // Nothing but the file is left in the directory (no temporary files).
+    EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()), 1);
+
+    back = read_binary_file(dir / "missing.hbvh");
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().file, (dir / "missing.hbvh").string());
+    EXPECT_NE(back.error().message.find("cannot open"), std::string::npos);
+    EXPECT_FALSE(read_binary_file(dir).has_value());
+    EXPECT_FALSE(write_binary_file(dir / "no_such_dir" / "x.hbvh", original));
+    std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace hbvh
