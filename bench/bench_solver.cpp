@@ -13,11 +13,13 @@
 #include <filesystem>
 #include <optional>
 
-#include "hbvh/build/bnb_exact.hpp"
-#include "hbvh/build/bottom_up.hpp"
-#include "hbvh/build/candidates.hpp"
-#include "hbvh/build/optimal.hpp"
-#include "hbvh/build/set_partition.hpp"
+#include "builders/bottom_up.hpp"
+#include "builders/candidates.hpp"
+#include "builders/optimal_plan.hpp"
+#include "builders/set_partition.hpp"
+#include "hbvh/builders/bnb_enlarge.hpp"
+#include "hbvh/builders/bnb_exact.hpp"
+#include "hbvh/builders/optimal.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -129,10 +131,10 @@ BENCHMARK(BM_level_table)->Iterations(1);
 void BM_rich_vs_enlarge(benchmark::State& state) {
     const auto primitives = tie_model();
     for (auto _ : state) {
-        ExactBottomUpOptions alone;
+        BnbExactOptions alone;
         alone.guarantee_enlarge = false;
-        const double rich = cost(build_bnb_exact(primitives, VolumePolicy::all(), alone));
-        const double enlarge = cost(build_bnb_enlarge(primitives, VolumePolicy::all()));
+        const double rich = cost(build_bnb_exact(primitives, BuildContext{}, alone).value());
+        const double enlarge = cost(build_bnb_enlarge(primitives, BuildContext{}).value());
         state.counters["rich_cost"] = rich;
         state.counters["enlarge_cost"] = enlarge;
         state.counters["ratio"] = rich / enlarge;
@@ -166,7 +168,9 @@ void BM_optimal_build(benchmark::State& state) {
     const auto primitives = generate_scene({.count = n, .seed = 3});
     VolumePolicy policy = VolumePolicy::all();
     if (state.range(1) == 0) policy.allowed = {true, false, true, false};
-    for (auto _ : state) benchmark::DoNotOptimize(build_optimal(primitives, policy));
+    BuildContext context;
+    context.policy = policy;
+    for (auto _ : state) benchmark::DoNotOptimize(build_optimal(primitives, context));
 }
 BENCHMARK(BM_optimal_build)->Args({13, 0})->Args({15, 0})->Args({17, 0})->Args({13, 1})->Unit(benchmark::kMillisecond)->Iterations(1);
 

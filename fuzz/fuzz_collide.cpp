@@ -19,7 +19,7 @@
 #include <utility>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -340,7 +340,7 @@ std::optional<Built> build_checked(const std::vector<Primitive>& primitives, con
                                    const hbvh::VolumePolicy& policy) {
     // HBVH_FUZZ_TIMING=1 prints each build's time (to set size_limit).
     static const bool timing = std::getenv("HBVH_FUZZ_TIMING") != nullptr;
-    hbvh::BuildOptions options;
+    hbvh::BuildContext options;
     options.policy = policy;
     const auto start = std::chrono::steady_clock::now();
     hbvh::Result<hbvh::Bvh> bvh = hbvh::build(primitives, info.algorithm, options);

@@ -13,7 +13,7 @@
 #include <string_view>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/query/tandem_traversal.hpp"

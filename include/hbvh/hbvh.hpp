@@ -32,20 +32,20 @@
 #include <hbvh/tree/validate.hpp>
 
 // The builders: build.hpp (build(), Algorithm) and the registry first, then one header per builder.
-#include <hbvh/builders/build.hpp>
-#include <hbvh/builders/registry.hpp>
-#include <hbvh/builders/context.hpp>
-#include <hbvh/builders/budget.hpp>
-#include <hbvh/builders/report.hpp>
 #include <hbvh/builders/auto.hpp>
 #include <hbvh/builders/bnb_enlarge.hpp>
 #include <hbvh/builders/bnb_exact.hpp>
 #include <hbvh/builders/bnb_tightest.hpp>
+#include <hbvh/builders/budget.hpp>
+#include <hbvh/builders/build.hpp>
+#include <hbvh/builders/context.hpp>
 #include <hbvh/builders/insertion.hpp>
 #include <hbvh/builders/insertion_haber.hpp>
 #include <hbvh/builders/merge.hpp>
 #include <hbvh/builders/obbtree.hpp>
 #include <hbvh/builders/optimal.hpp>
+#include <hbvh/builders/registry.hpp>
+#include <hbvh/builders/report.hpp>
 #include <hbvh/builders/scale.hpp>
 #include <hbvh/builders/split.hpp>
 #include <hbvh/builders/treelet.hpp>

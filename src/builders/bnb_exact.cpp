@@ -4,12 +4,15 @@
 // Per level the solver is exact and the candidate set contains Enlarge's, so each level's choice costs
 // no more than B&B-Enlarge's would on the same level. Later levels differ, though, so that alone does not
 // bound the whole tree; guarantee_enlarge builds bnb-enlarge as well and keeps the cheaper (docs/solver.md §3).
-#include "hbvh/build/bnb_exact.hpp"
+#include "hbvh/builders/bnb_exact.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 
-#include "hbvh/build/candidates.hpp"
+#include "candidates.hpp"
+#include "guarded_build.hpp"
+#include "rich_candidates.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
@@ -53,27 +56,45 @@ LevelSolver exact_level_solver() {
               const SolverBudget& budget) { return solve_exact(node_count, candidates, budget); };
 }
 
-Bvh build_bnb_exact(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                    const ExactBottomUpOptions& options, BuildReport* report) {
-    const std::uint32_t k = options.nearest_neighbours;
-    BuildReport exact_report;
-    Bvh exact = build_bottom_up(
-        primitives, policy, [k](const Level& level) { return rich_candidates(level, k); }, exact_level_solver(),
-        {options.budget, report != nullptr ? &exact_report : nullptr});
-    if (options.guarantee_enlarge) {
-        BuildReport enlarge_report;
-        Bvh enlarge = build_bnb_enlarge(primitives, policy, options.enlarge_options,
-                                        report != nullptr ? &enlarge_report : nullptr);
-        if (cost(enlarge, policy) < cost(exact, policy)) {
-            if (report != nullptr) {
-                *report = std::move(enlarge_report);
-                report->notes.push_back("bnb-exact: bnb-enlarge's tree was cheaper and is returned");
-            }
-            return enlarge;
+Result<Bvh> build_bnb_exact(std::span<const Primitive> primitives, const BuildContext& context,
+                            const BnbExactOptions& options) {
+    // The deadline becomes solver budgets (so levels always complete with the best partition found);
+    // the checkpoint only reports progress.
+    BuildContext progress_only = context;
+    progress_only.deadline = BuildContext::Clock::time_point::max();
+    return detail::guarded_build(primitives, progress_only, "bnb-exact", static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+        BnbExactOptions within = options;
+        if (context.has_deadline()) {
+            const double calls = 2.0 * std::max(1.0, std::log2(static_cast<double>(primitives.size())));
+            const double share = std::max(context.seconds_left(), 1e-9) / calls;
+            within.budget.max_seconds = 0.5 * share;
+            within.enlarge_options.budget.max_seconds = 0.5 * share;
         }
-    }
-    if (report != nullptr) *report = std::move(exact_report);
-    return exact;
+        const std::uint32_t k = within.nearest_neighbours;
+        BuildReport* report = context.report;
+        BuildReport exact_report;
+        Bvh exact = build_bottom_up(
+            primitives, context.policy, [k](const Level& level) { return rich_candidates(level, k); },
+            exact_level_solver(), {within.budget, report != nullptr ? &exact_report : nullptr, &checkpoint});
+        if (within.guarantee_enlarge) {
+            BuildReport enlarge_report;
+            BuildContext enlarge_context = progress_only;
+            enlarge_context.report = report != nullptr ? &enlarge_report : nullptr;
+            enlarge_context.progress = nullptr;
+            Result<Bvh> enlarge = build_bnb_enlarge(primitives, enlarge_context, within.enlarge_options);
+            if (!enlarge) return enlarge;
+            if (cost(*enlarge, context.policy) < cost(exact, context.policy)) {
+                if (report != nullptr) {
+                    *report = std::move(enlarge_report);
+                    report->notes.push_back("bnb-exact: bnb-enlarge's tree was cheaper and is returned");
+                }
+                return enlarge;
+            }
+        }
+        if (report != nullptr) *report = std::move(exact_report);
+        return Result<Bvh>(std::move(exact));
+    });
 }
 
 }  // namespace hbvh

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // The generic bottom-up driver (survey §3, Appendix A Algorithm 1): heuristic -> set partition -> next level.
-#include "hbvh/build/bottom_up.hpp"
+#include "bottom_up.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -188,7 +188,9 @@ Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& p
     sort_canonically(nodes, ids);
 
     std::uint32_t level_index = 0;
+    const double primitive_count = static_cast<double>(primitives.size());
     while (nodes.size() > 1) {
+        if (options.checkpoint != nullptr) options.checkpoint->step(primitive_count - static_cast<double>(nodes.size()));
         const auto start = std::chrono::steady_clock::now();
         const Level level(primitives, std::move(nodes), policy);
         const std::uint32_t n = level.size();

@@ -7,7 +7,7 @@
 #include <tuple>
 
 #include "hbvh/assert.hpp"
-#include "hbvh/build/candidates.hpp"
+#include "candidates.hpp"
 #include "hbvh/geometry/overlap.hpp"
 
 namespace hbvh {

@@ -4,7 +4,7 @@
 #include <limits>
 #include <set>
 
-#include "hbvh/build/candidates.hpp"
+#include "candidates.hpp"
 
 namespace hbvh {
 

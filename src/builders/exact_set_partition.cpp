@@ -17,7 +17,7 @@
 #include <unordered_map>
 
 #include "hbvh/assert.hpp"
-#include "hbvh/build/set_partition.hpp"
+#include "set_partition.hpp"
 
 namespace hbvh {
 namespace {

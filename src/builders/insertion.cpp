@@ -1,9 +1,10 @@
 // SPDX-License-Identifier: MIT
 // Goldsmith and Salmon's incremental insertion (IEEE CG&A 1987; survey §2.1), with Haines' refinement.
-#include "hbvh/build/incremental_insert.hpp"
+#include "hbvh/builders/insertion.hpp"
 
 #include <numeric>
 
+#include "guarded_build.hpp"
 #include "insertion_tree.hpp"
 
 namespace hbvh {
@@ -59,22 +60,25 @@ Placement choose_placement(const InsertionTree& tree, std::uint32_t item) {
 
 }  // namespace
 
-Result<Bvh> build_incremental_insert(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                     const InsertionOptions& /*options*/) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
-    // Input order is the insertion order: the identity permutation.
-    std::vector<std::uint32_t> order(primitives.size());
-    std::iota(order.begin(), order.end(), 0u);
-    const detail::PrimitiveSet set(primitives, std::move(order), policy);
-    InsertionTree tree(set);
-    for (std::uint32_t local = 0; local < set.size(); ++local) {
-        const std::uint32_t leaf = tree.make_leaf(local);
-        if (tree.root() == detail::no_node)
-            tree.attach(leaf, {});
-        else
-            tree.attach(leaf, choose_placement(tree, leaf));
-    }
-    return tree.to_bvh(primitives);
+Result<Bvh> build_insertion(std::span<const Primitive> primitives, const BuildContext& context,
+                            const InsertionOptions& /*options*/) {
+    return detail::guarded_build(primitives, context, "insertion", static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+        // Input order is the insertion order: the identity permutation.
+        std::vector<std::uint32_t> order(primitives.size());
+        std::iota(order.begin(), order.end(), 0u);
+        const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
+        InsertionTree tree(set);
+        for (std::uint32_t local = 0; local < set.size(); ++local) {
+            checkpoint.step(local);
+            const std::uint32_t leaf = tree.make_leaf(local);
+            if (tree.root() == detail::no_node)
+                tree.attach(leaf, {});
+            else
+                tree.attach(leaf, choose_placement(tree, leaf));
+        }
+        return tree.to_bvh(primitives);
+    });
 }
 
 }  // namespace hbvh

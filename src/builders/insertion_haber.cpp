@@ -3,13 +3,15 @@
 // and the two global optimisations the survey names, Successive Re-Insertion and Elimination of
 // Ill-formed Groups. The paper itself was not available to us; what follows is built from the survey's
 // description and documented as such in docs/algorithms-heuristics.md.
-#include "hbvh/build/incremental_insert_haber.hpp"
+#include "hbvh/builders/insertion_haber.hpp"
 
 #include <algorithm>
 #include <limits>
 #include <numeric>
 #include <queue>
+#include <string>
 
+#include "guarded_build.hpp"
 #include "insertion_tree.hpp"
 
 namespace hbvh {
@@ -46,7 +48,7 @@ struct Frontier {
 // exact only for rules 1-3; the search is a heuristic for rule 4, which is why it is capped.
 // `exclude` (a node still in the tree) is skipped as a partner, so a leaf can be priced for re-insertion
 // before it is taken out.
-Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInsertionOptions& options,
+Placement search(const InsertionTree& tree, std::uint32_t item, const InsertionHaberOptions& options,
                  std::uint32_t exclude = no_node) {
     const std::uint32_t root = tree.root();
     const double root_grown = tree.estimate_union(root, item);
@@ -96,7 +98,7 @@ Placement search(const InsertionTree& tree, std::uint32_t item, const HaberInser
     return best;
 }
 
-void insert(InsertionTree& tree, std::uint32_t item, const HaberInsertionOptions& options) {
+void insert(InsertionTree& tree, std::uint32_t item, const InsertionHaberOptions& options) {
     if (tree.root() == no_node)
         tree.attach(item, {});
     else
@@ -113,7 +115,7 @@ bool is_live_group(const InsertionTree& tree, std::uint32_t id) {
 // Badness criteria for Elimination of Ill-formed Groups: loose (Eq. 1 tightness above the limit) or
 // dominated (one child nearly as big as the group, so the others hang around it rather than belong).
 // Returns the tightness for ordering, or 0 when the group is well formed.
-double ill_formed_score(const InsertionTree& tree, std::uint32_t id, const HaberInsertionOptions& options) {
+double ill_formed_score(const InsertionTree& tree, std::uint32_t id, const InsertionHaberOptions& options) {
     const auto& node = tree.node(id);
     double sum = 0.0, largest = 0.0;
     for (const std::uint32_t c : node.children) {
@@ -140,11 +142,18 @@ double removal_gain(const InsertionTree& tree, std::uint32_t leaf) {
 
 class Optimizer {
 public:
-    Optimizer(InsertionTree& tree, const HaberInsertionOptions& options)
+    Optimizer(InsertionTree& tree, const InsertionHaberOptions& options)
         : tree_(tree), options_(options), cost_(tree.cost()) {}
 
-    void run() {
+    /// Rounds until one gains too little, or the deadline passes (anytime: every kept step lowered the cost).
+    void run(const BuildContext& context) {
         for (std::uint32_t round = 0; round < options_.optimization_rounds; ++round) {
+            if (context.expired()) {
+                context.note_deadline("insertion-haber: time limit reached after " + std::to_string(round) +
+                                      " optimisation rounds; returned the tree as optimised so far");
+                break;
+            }
+            context.report_progress(0.5 + 0.5 * round / options_.optimization_rounds);
             const double start = cost_;
             reinsert_leaves();
             eliminate_ill_formed_groups();
@@ -207,22 +216,28 @@ private:
     }
 
     InsertionTree& tree_;
-    const HaberInsertionOptions& options_;
+    const InsertionHaberOptions& options_;
     double cost_;
 };
 
 }  // namespace
 
-Result<Bvh> build_incremental_insert_haber(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                           const HaberInsertionOptions& options) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
-    std::vector<std::uint32_t> order(primitives.size());
-    std::iota(order.begin(), order.end(), 0u);  // input order is the insertion order
-    const detail::PrimitiveSet set(primitives, std::move(order), policy);
-    InsertionTree tree(set);
-    for (std::uint32_t local = 0; local < set.size(); ++local) insert(tree, tree.make_leaf(local), options);
-    Optimizer(tree, options).run();
-    return tree.to_bvh(primitives);
+Result<Bvh> build_insertion_haber(std::span<const Primitive> primitives, const BuildContext& context,
+                                  const InsertionHaberOptions& options) {
+    // Insertion is the first half of the progress, the optimisation rounds the second.
+    return detail::guarded_build(primitives, context, "insertion-haber", 2.0 * static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+        std::vector<std::uint32_t> order(primitives.size());
+        std::iota(order.begin(), order.end(), 0u);  // input order is the insertion order
+        const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
+        InsertionTree tree(set);
+        for (std::uint32_t local = 0; local < set.size(); ++local) {
+            checkpoint.step(local);
+            insert(tree, tree.make_leaf(local), options);
+        }
+        Optimizer(tree, options).run(context);
+        return tree.to_bvh(primitives);
+    });
 }
 
 }  // namespace hbvh

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
 // OpenTissue's bottom-up construction (Erleben et al., "Physics-Based Animation", 2005; survey §2.3).
-#include "hbvh/build/bottom_up_merge.hpp"
+#include "hbvh/builders/merge.hpp"
 
 #include <algorithm>
 #include <iterator>
@@ -9,6 +9,7 @@
 #include <optional>
 #include <queue>
 
+#include "guarded_build.hpp"
 #include "heuristic_support.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/geometry/overlap.hpp"
@@ -48,8 +49,9 @@ struct LaterEdge {
 
 class MergeBuilder {
 public:
-    MergeBuilder(const PrimitiveSet& set, TreeAssembler& assembler, const MergeOptions& options)
-        : set_(set), assembler_(assembler), branching_(std::max<std::uint32_t>(options.branching_factor, 2)),
+    MergeBuilder(const PrimitiveSet& set, TreeAssembler& assembler, const MergeOptions& options,
+                 const detail::Checkpoint& checkpoint)
+        : set_(set), assembler_(assembler), checkpoint_(checkpoint), branching_(std::max<std::uint32_t>(options.branching_factor, 2)),
           enlargement_(options.enlargement > 1.0 ? options.enlargement : 1.25), exact_(options.exact_priorities) {}
 
     std::uint32_t build() {
@@ -64,6 +66,7 @@ public:
         alive_count_ = set_.size();
         // Stage 1: collapse edges until one graph-node is left, reconnecting whenever edges run out.
         while (alive_count_ > 1) {
+            checkpoint_.step(static_cast<double>(set_.size() - alive_count_));
             if (edge_count_ == 0) connect();
             const Edge edge = pop_live_edge();
             collapse(edge);
@@ -234,6 +237,7 @@ private:
 
     const PrimitiveSet& set_;
     TreeAssembler& assembler_;
+    const detail::Checkpoint& checkpoint_;
     std::uint32_t branching_;
     double enlargement_;
     bool exact_;
@@ -245,13 +249,15 @@ private:
 
 }  // namespace
 
-Result<Bvh> build_bottom_up_merge(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                  const MergeOptions& options) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
-    const PrimitiveSet set(primitives, detail::canonical_order(primitives), policy);
-    TreeAssembler assembler(primitives);
-    const std::uint32_t root = MergeBuilder(set, assembler, options).build();
-    return std::move(assembler).finish(root);
+Result<Bvh> build_merge(std::span<const Primitive> primitives, const BuildContext& context,
+                        const MergeOptions& options) {
+    return detail::guarded_build(primitives, context, "merge", static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+                                     const PrimitiveSet set(primitives, detail::canonical_order(primitives), context.policy);
+                                     TreeAssembler assembler(primitives);
+                                     const std::uint32_t root = MergeBuilder(set, assembler, options, checkpoint).build();
+                                     return std::move(assembler).finish(root);
+                                 });
 }
 
 }  // namespace hbvh

@@ -1,11 +1,12 @@
 // SPDX-License-Identifier: MIT
 // Gottschalk, Lin and Manocha's OBB-tree construction (SIGGRAPH 1996; survey §2.2).
-#include "hbvh/build/obb_tree.hpp"
+#include "hbvh/builders/obbtree.hpp"
 
 #include <algorithm>
 #include <array>
 #include <numeric>
 
+#include "guarded_build.hpp"
 #include "heuristic_support.hpp"
 #include "hbvh/fit/fit.hpp"
 
@@ -16,11 +17,16 @@ using detail::PrimitiveSet;
 
 class ObbTreeBuilder {
 public:
-    ObbTreeBuilder(const PrimitiveSet& set, TreeAssembler& assembler, const ObbTreeOptions& options)
-        : set_(set), assembler_(assembler), options_(options) {}
+    ObbTreeBuilder(const PrimitiveSet& set, TreeAssembler& assembler, const ObbTreeOptions& options,
+                   const detail::Checkpoint& checkpoint)
+        : set_(set), assembler_(assembler), options_(options), checkpoint_(checkpoint) {}
 
     std::uint32_t build(std::vector<std::uint32_t> locals) {
-        if (locals.size() == 1) return assembler_.add_leaf(set_.input_index(locals.front()));
+        if (locals.size() == 1) {
+            ++placed_;
+            return assembler_.add_leaf(set_.input_index(locals.front()));
+        }
+        checkpoint_.step(static_cast<double>(placed_));
         // Summing in canonical order keeps the covariance, and so every later decision, bitwise
         // independent of the input order.
         std::sort(locals.begin(), locals.end());
@@ -74,19 +80,24 @@ private:
     const PrimitiveSet& set_;
     TreeAssembler& assembler_;
     const ObbTreeOptions& options_;
+    const detail::Checkpoint& checkpoint_;
+    std::uint32_t placed_ = 0;  ///< Leaves added so far, for progress.
 };
 
 }  // namespace
 
-Result<Bvh> build_obb_tree(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                           const ObbTreeOptions& options) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
-    const PrimitiveSet set(primitives, detail::canonical_order(primitives), policy);
-    TreeAssembler assembler(primitives);
-    std::vector<std::uint32_t> all(set.size());
-    std::iota(all.begin(), all.end(), 0u);
-    const std::uint32_t root = ObbTreeBuilder(set, assembler, options).build(std::move(all));
-    return std::move(assembler).finish(root);
+Result<Bvh> build_obbtree(std::span<const Primitive> primitives, const BuildContext& context,
+                          const ObbTreeOptions& options) {
+    return detail::guarded_build(primitives, context, "obbtree", static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+                                     const PrimitiveSet set(primitives, detail::canonical_order(primitives), context.policy);
+                                     TreeAssembler assembler(primitives);
+                                     std::vector<std::uint32_t> all(set.size());
+                                     std::iota(all.begin(), all.end(), 0u);
+                                     const std::uint32_t root =
+                                         ObbTreeBuilder(set, assembler, options, checkpoint).build(std::move(all));
+                                     return std::move(assembler).finish(root);
+                                 });
 }
 
 }  // namespace hbvh

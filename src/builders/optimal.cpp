@@ -11,7 +11,8 @@
 // number (3^n - 1)/2, each with an inner loop over k <= |S \ B|, so the time is O(n·3^n) worst case and
 // about (n/3)·3^n/2 in practice; memory is n·2^n doubles. Subsets are visited in increasing integer
 // order, which lists every proper subset before its superset.
-#include "hbvh/build/optimal.hpp"
+#include "hbvh/builders/optimal.hpp"
+#include "optimal_plan.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -19,11 +20,13 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <cmath>
 #include <limits>
 #include <string>
 
+#include "guarded_build.hpp"
 #include "hbvh/assert.hpp"
-#include "hbvh/build/bnb_exact.hpp"
+#include "hbvh/builders/bnb_exact.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
@@ -134,21 +137,37 @@ OptimalPlan solve_optimal_hierarchy(std::uint32_t count, std::span<const double>
     return plan;
 }
 
-Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                          const OptimalOptions& options, BuildReport* report) {
-    const auto start = std::chrono::steady_clock::now();
+namespace {
+Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildContext& context, std::uint32_t limit,
+                         const detail::Checkpoint& checkpoint);
+}  // namespace
+
+Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildContext& context,
+                          const OptimalOptions& options) {
     const std::uint32_t limit = std::min(options.max_primitives, optimal_hard_limit);
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
     if (primitives.size() > limit && options.fall_back) {
         // Documented refusal of the DP, but a tree all the same (docs/solver.md §2).
-        Bvh fallback = build_bnb_exact(primitives, policy, {}, report);
-        if (report != nullptr) {
-            report->lower_bound = 0.0;
-            report->notes.push_back("optimal: " + std::to_string(primitives.size()) + " primitives exceed the limit of " +
-                                    std::to_string(limit) + "; built bnb-exact instead (not proven optimal)");
+        Result<Bvh> fallback = build_bnb_exact(primitives, context);
+        if (fallback && context.report != nullptr) {
+            context.report->lower_bound = 0.0;
+            context.report->notes.push_back("optimal: " + std::to_string(primitives.size()) +
+                                            " primitives exceed the limit of " + std::to_string(limit) +
+                                            "; built bnb-exact instead (not proven optimal)");
         }
         return fallback;
     }
+    const double subsets = std::ldexp(1.0, static_cast<int>(std::min<std::size_t>(primitives.size(), 30)));
+    return detail::guarded_build(primitives, context, "optimal", subsets, [&](const detail::Checkpoint& checkpoint) {
+        return optimal_tree(primitives, context, limit, checkpoint);
+    });
+}
+
+namespace {
+Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildContext& context, std::uint32_t limit,
+                         const detail::Checkpoint& checkpoint) {
+    const auto start = std::chrono::steady_clock::now();
+    const VolumePolicy& policy = context.policy;
+    BuildReport* report = context.report;
     if (primitives.size() > limit)
         return Error{"the optimal builder handles at most " + std::to_string(limit) + " primitives, got " +
                      std::to_string(primitives.size()) + " (its subset DP is exponential; see docs/solver.md)"};
@@ -169,10 +188,12 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePol
     std::vector<double> volume(std::size_t{1} << count, 0.0);
     tbb::parallel_for(tbb::blocked_range<std::uint32_t>(1, 1u << count, 512),
                       [&](const tbb::blocked_range<std::uint32_t>& range) {
+                          checkpoint.step(range.begin());  // blocks in any order: progress is approximate
                           for (std::uint32_t mask = range.begin(); mask != range.end(); ++mask)
                               if (std::popcount(mask) > 1) volume[mask] = policy.weighted_volume(fit_subset(mask));
                       });
 
+    checkpoint.step(static_cast<double>(1u << count));
     // Stage 2: the DP, then the tree it chose (children before parents for the assembler).
     const OptimalPlan plan = solve_optimal_hierarchy(count, volume);
     std::vector<std::uint32_t> id_of(std::size_t{1} << count, 0);
@@ -193,5 +214,6 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePol
     }
     return std::move(assembler).finish(id_of[(1u << count) - 1u]);
 }
+}  // namespace
 
 }  // namespace hbvh

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "hbvh/assert.hpp"
-#include "hbvh/build/set_partition.hpp"
+#include "set_partition.hpp"
 
 namespace hbvh {
 namespace {

@@ -7,7 +7,7 @@
 // independent instance for solve_exact over candidates that lie inside it. A level is then O(n) window
 // solves of bounded size, and a build O(n log n) (the Morton sort). docs/scale.md has the argument and the
 // measured numbers.
-#include "hbvh/build/scale.hpp"
+#include "hbvh/builders/scale.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -18,7 +18,10 @@
 #include <limits>
 #include <numeric>
 
+#include "guarded_build.hpp"
+#include "set_partition.hpp"
 #include "hbvh/assert.hpp"
+#include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
@@ -287,10 +290,10 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
 
 }  // namespace
 
-Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& policy, const ScaleOptions& options,
-                BuildReport* report) {
-    HBVH_ASSERT(!primitives.empty());
-    const auto start = Clock::now();
+namespace {
+Bvh scale_tree(std::span<const Primitive> primitives, const BuildContext& context, const ScaleOptions& options) {
+    const VolumePolicy& policy = context.policy;
+    BuildReport* report = context.report;
     const std::uint32_t n0 = static_cast<std::uint32_t>(primitives.size());
     TreeAssembler assembler(primitives);
 
@@ -316,10 +319,9 @@ Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& polic
         const std::uint32_t exact_limit = n0 <= options.exact_fit_all_up_to ? n0 : options.exact_fit_max_primitives;
         const bool refit_level = n <= options.exact_fit_level_nodes && n0 <= options.exact_fit_level_max_input;
         LevelContext level{primitives, policy, options, exact_limit, refit_level, nodes, level_primitives, {}, false};
-        if (options.time_limit_seconds > 0.0) {
+        if (context.has_deadline()) {
             level.has_deadline = true;
-            level.deadline = start + std::chrono::duration_cast<Clock::duration>(
-                                         std::chrono::duration<double>(options.time_limit_seconds));
+            level.deadline = context.deadline;
         }
 
         // Stage 1: every window on its own (parallel), each into its own slot.
@@ -373,15 +375,22 @@ Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& polic
         // Work per level is about proportional to its node count and levels shrink geometrically (by
         // ~2.5), so the levels still to come are worth about 1.7 x the next one.
         work_done += n;
-        if (options.progress) {
-            const double remaining = nodes.size() > 1 ? 1.7 * static_cast<double>(nodes.size()) : 0.0;
-            options.progress(static_cast<double>(work_done) / (static_cast<double>(work_done) + remaining));
-        }
+        const double remaining = nodes.size() > 1 ? 1.7 * static_cast<double>(nodes.size()) : 0.0;
+        context.report_progress(static_cast<double>(work_done) / (static_cast<double>(work_done) + remaining));
     }
-    if (report != nullptr && options.time_limit_seconds > 0.0 && report->budget_hit)
+    if (report != nullptr && context.has_deadline() && report->budget_hit)
         report->notes.push_back("scale: the time limit cut the search; remaining windows kept their initial cover");
-    if (options.progress && n0 == 1) options.progress(1.0);
     return std::move(assembler).finish(nodes.front().id);
+}
+}  // namespace
+
+Result<Bvh> build_scale(std::span<const Primitive> primitives, const BuildContext& context, const ScaleOptions& options) {
+    // Anytime: the deadline makes the remaining windows keep their initial cover, so levels always complete;
+    // the guard's checkpoint is not used for it.
+    BuildContext no_deadline = context;
+    no_deadline.deadline = BuildContext::Clock::time_point::max();
+    return detail::guarded_build(primitives, no_deadline, "scale", 1.0,
+                                 [&](const detail::Checkpoint&) { return Result<Bvh>(scale_tree(primitives, context, options)); });
 }
 
 }  // namespace hbvh

@@ -1,10 +1,11 @@
 // SPDX-License-Identifier: MIT
 // Müller, Schäfer and Straßer's top-down splitting (survey §2.2): sort, sweep every cut point, recurse.
-#include "hbvh/build/top_down_split.hpp"
+#include "hbvh/builders/split.hpp"
 
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -12,6 +13,7 @@
 #include <span>
 #include <vector>
 
+#include "guarded_build.hpp"
 #include "heuristic_support.hpp"
 #include "hbvh/fit/fit.hpp"
 
@@ -105,8 +107,8 @@ struct PlannedNode {
 /// the same for any thread count.
 class Splitter {
 public:
-    Splitter(const PrimitiveSet& set, const SplitOptions& options)
-        : set_(set), options_(options), order_(set.size()), plan_(2 * set.size() - 1) {
+    Splitter(const PrimitiveSet& set, const SplitOptions& options, const detail::Checkpoint& checkpoint)
+        : set_(set), options_(options), checkpoint_(checkpoint), order_(set.size()), plan_(2 * set.size() - 1) {
         std::iota(order_.begin(), order_.end(), 0u);
     }
 
@@ -122,8 +124,10 @@ private:
     std::uint32_t plan(std::uint32_t begin, std::uint32_t end) {
         if (end - begin == 1) {
             plan_[begin] = PlannedNode{true, order_[begin], 0, 0, {}};
+            placed_.fetch_add(1, std::memory_order_relaxed);
             return begin;
         }
+        checkpoint_.step(static_cast<double>(placed_.load(std::memory_order_relaxed)));
         const std::span<std::uint32_t> locals(order_.data() + begin, end - begin);
         BoundingVolume volume = set_.fit(locals);
         const auto cut = begin + static_cast<std::uint32_t>(choose_cut(locals));  // sorts locals along the chosen axis
@@ -213,19 +217,23 @@ private:
 
     const PrimitiveSet& set_;
     const SplitOptions& options_;
+    const detail::Checkpoint& checkpoint_;
+    std::atomic<std::uint64_t> placed_{0};  ///< Leaves planned so far, for progress (any thread).
     std::vector<std::uint32_t> order_;  ///< Local primitive indices; each plan() call sorts only its range.
     std::vector<PlannedNode> plan_;     ///< n leaves, then n - 1 inner nodes by their cut position.
 };
 
 }  // namespace
 
-Result<Bvh> build_top_down_split(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                 const SplitOptions& options) {
-    if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
-    const PrimitiveSet set(primitives, detail::canonical_order(primitives), policy);
-    TreeAssembler assembler(primitives);
-    const std::uint32_t root = Splitter(set, options).build(assembler);
-    return std::move(assembler).finish(root);
+Result<Bvh> build_split(std::span<const Primitive> primitives, const BuildContext& context,
+                        const SplitOptions& options) {
+    return detail::guarded_build(primitives, context, "split", static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+                                     const PrimitiveSet set(primitives, detail::canonical_order(primitives), context.policy);
+                                     TreeAssembler assembler(primitives);
+                                     const std::uint32_t root = Splitter(set, options, checkpoint).build(assembler);
+                                     return std::move(assembler).finish(root);
+                                 });
 }
 
 }  // namespace hbvh

@@ -7,7 +7,7 @@
 // Eq. 2 cost is a constant plus the sum over its new inner nodes of children x vol(BV of the primitives
 // below). That is exactly the problem solve_optimal_hierarchy solves with the units as its leaves, with
 // subset_volume[mask] = weighted volume of the BV over the primitives of the units in mask.
-#include "hbvh/build/treelet.hpp"
+#include "hbvh/builders/treelet.hpp"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -20,7 +20,8 @@
 #include <vector>
 
 #include "hbvh/assert.hpp"
-#include "hbvh/build/optimal.hpp"
+#include "hbvh/builders/optimal.hpp"
+#include "optimal_plan.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/tree/stats.hpp"
 

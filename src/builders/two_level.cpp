@@ -1,13 +1,20 @@
 // SPDX-License-Identifier: MIT
-#include "hbvh/build/two_level.hpp"
+#include "hbvh/builders/two_level.hpp"
 
 #include <numeric>
 
+#include "guarded_build.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
 
-Bvh build_two_level(std::span<const Primitive> primitives, const VolumePolicy& policy) {
+Result<Bvh> build_two_level(std::span<const Primitive> primitives, const BuildContext& context,
+                            const TwoLevelOptions& /*options*/) {
+    return detail::guarded_build(primitives, context, "two-level", 1.0,
+                                 [&](const detail::Checkpoint&) { return detail::two_level_tree(primitives, context.policy); });
+}
+
+Bvh detail::two_level_tree(std::span<const Primitive> primitives, const VolumePolicy& policy) {
     TreeAssembler assembler(primitives);
     std::vector<std::uint32_t> leaves(primitives.size());
     FitInput input;

@@ -14,12 +14,17 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/bnb_exact.hpp"
-#include "hbvh/build/build.hpp"
+#include "builders/bottom_up.hpp"
+#include "builders/candidates.hpp"
+#include "builders/rich_candidates.hpp"
+#include "builders/set_partition.hpp"
+#include "hbvh/builders/bnb_exact.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/test_helpers.hpp"
 
 namespace hbvh {
 namespace {
@@ -74,8 +79,8 @@ double exhaustive_optimum(std::uint32_t node_count, std::span<const Candidate> c
 /// driver) so that every level can be looked at; `records` gets one entry per level.
 Bvh build_instrumented(const std::vector<Primitive>& primitives, const VolumePolicy& policy,
                        std::vector<LevelRecord>& records) {
-    const ExactBottomUpOptions exact_options;
-    const BranchAndBoundOptions enlarge_options;
+    const BnbExactOptions exact_options;
+    const BnbEnlargeOptions enlarge_options;
     auto generate = [&](const Level& level) {
         LevelRecord record;
         record.nodes = level.size();
@@ -127,9 +132,9 @@ int expect_exact_levels(const std::vector<Primitive>& primitives, const std::str
     const VolumePolicy policy = VolumePolicy::all();
     std::vector<LevelRecord> records;
     const Bvh instrumented = build_instrumented(primitives, policy, records);
-    ExactBottomUpOptions no_net;
+    BnbExactOptions no_net;
     no_net.guarantee_enlarge = false;
-    const Bvh exact_alone = build_bnb_exact(primitives, policy, no_net);
+    const Bvh exact_alone = build_bnb_exact(primitives, test_support::context_for(policy), no_net).value();
     // The instrumented build is the library's bnb-exact search, not a look-alike.
     EXPECT_EQ(cost(instrumented, policy), cost(exact_alone, policy)) << what;
     const Status valid = validate(exact_alone);
@@ -180,15 +185,15 @@ int expect_exact_levels(const std::vector<Primitive>& primitives, const std::str
 /// The safety net: the registered builder returns exactly the cheaper of bnb-exact's own tree and
 /// bnb-enlarge's. Returns whether bnb-enlarge's was the cheaper.
 bool expect_cheaper_of_both(const std::vector<Primitive>& primitives, const std::string& what) {
-    BuildOptions options;
     BuildReport report;
-    options.report = &report;
-    const Result<Bvh> chosen = build(primitives, Algorithm::bnb_exact, options);
-    options.report = nullptr;
-    const Result<Bvh> enlarge = build(primitives, Algorithm::bnb_enlarge, options);
-    ExactBottomUpOptions no_net;
+    BuildContext context;
+    context.report = &report;
+    const Result<Bvh> chosen = build(primitives, Algorithm::bnb_exact, context);
+    context.report = nullptr;
+    const Result<Bvh> enlarge = build(primitives, Algorithm::bnb_enlarge, context);
+    BnbExactOptions no_net;
     no_net.guarantee_enlarge = false;
-    const Bvh exact_alone = build_bnb_exact(primitives, options.policy, no_net);
+    const Bvh exact_alone = build_bnb_exact(primitives, context, no_net).value();
     if (!chosen.has_value() || !enlarge.has_value()) {
         ADD_FAILURE() << what << ": a build failed";
         return false;

@@ -6,7 +6,7 @@
 #include <optional>
 #include <vector>
 
-#include "hbvh/build/bottom_up.hpp"
+#include "builders/bottom_up.hpp"
 #include "hbvh/tree/validate.hpp"
 #include "support/test_helpers.hpp"
 

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/branch_and_bound.hpp"
-#include "hbvh/build/build.hpp"
+#include "builders/survey_branch_and_bound.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -27,12 +27,18 @@ using test_support::shuffled;
 
 constexpr Algorithm bnb_algorithms[] = {Algorithm::bnb_tightest, Algorithm::bnb_enlarge};
 
-/// A small per-level budget keeps the exponential reference search inside the suite's time.
-BuildOptions test_options(BuildReport* report) {
-    BuildOptions options;
-    options.report = report;
-    options.branch_and_bound.budget.max_nodes = 200'000;
-    return options;
+/// `algorithm` (bnb-tightest or bnb-enlarge) with a small per-level budget, which keeps the exponential
+/// reference search inside the suite's time.
+Result<Bvh> build_budgeted(std::span<const Primitive> primitives, Algorithm algorithm, const BuildContext& context) {
+    constexpr std::uint64_t max_nodes = 200'000;
+    if (algorithm == Algorithm::bnb_tightest) {
+        BnbTightestOptions options;
+        options.budget.max_nodes = max_nodes;
+        return build_bnb_tightest(primitives, context, options);
+    }
+    BnbEnlargeOptions options;
+    options.budget.max_nodes = max_nodes;
+    return build_bnb_enlarge(primitives, context, options);
 }
 
 /// The checks every hierarchy must pass, with messages naming the scene.
@@ -93,16 +99,17 @@ TEST(BranchAndBoundBuilders, ValidOnGeneratedScenesAndInvariantUnderShuffles) {
                 const std::string what = std::string(to_string(algorithm)) + " n=" + std::to_string(count) +
                                          (clustered ? " clustered" : " uniform");
                 BuildReport report;
-                BuildOptions options = test_options(&report);
+                BuildContext options;
+                options.report = &report;
                 // Tightest's O(n^3) fits dominate the suite's time: the larger scenes use the two cheap kinds.
                 if (count >= 21) options.policy = *parse_allowed_types("aabb,sphere");
-                const Result<Bvh> bvh = build(primitives, algorithm, options);
+                const Result<Bvh> bvh = build_budgeted(primitives, algorithm, options);
                 ASSERT_TRUE(bvh.has_value()) << what;
                 expect_valid(*bvh, count, what);
                 expect_report_filled(report, count, what);
                 const double reference_cost = cost(*bvh);
                 options.report = nullptr;
-                const Result<Bvh> other = build(shuffled(primitives, count), algorithm, options);
+                const Result<Bvh> other = build_budgeted(shuffled(primitives, count), algorithm, options);
                 ASSERT_TRUE(other.has_value()) << what;
                 EXPECT_NEAR(cost(*other), reference_cost, 1e-9 * std::max(1.0, reference_cost)) << what;
             }
@@ -134,12 +141,12 @@ TEST(BranchAndBoundBuilders, ValidOnBundledModels) {
         for (Algorithm algorithm : bnb_algorithms) {
             const std::string what = std::string(to_string(algorithm)) + " " + file.filename().string();
             BuildReport report;
-            const Result<Bvh> bvh = build(primitives, algorithm, test_options(&report));
+            const Result<Bvh> bvh = build_budgeted(primitives, algorithm, test_support::context_for(VolumePolicy::all(), &report));
             ASSERT_TRUE(bvh.has_value()) << what;
             expect_valid(*bvh, primitives.size(), what);
             expect_report_filled(report, primitives.size(), what);
             if (algorithm == Algorithm::bnb_tightest) continue;  // its shuffles are covered on generated scenes
-            const Result<Bvh> other = build(shuffled(primitives, 11), algorithm, test_options(nullptr));
+            const Result<Bvh> other = build_budgeted(shuffled(primitives, 11), algorithm, BuildContext{});
             ASSERT_TRUE(other.has_value()) << what;
             EXPECT_NEAR(cost(*other), cost(*bvh), 1e-9 * cost(*bvh)) << what;
         }
@@ -159,7 +166,7 @@ TEST(BranchAndBoundBuilders, DISABLED_PrintSurvey) {
     for (const auto& [name, primitives] : inputs) {
         for (Algorithm algorithm : {Algorithm::two_level, Algorithm::bnb_tightest, Algorithm::bnb_enlarge}) {
             BuildReport report;
-            BuildOptions options;
+            BuildContext options;
             options.report = &report;
             const auto start = std::chrono::steady_clock::now();
             const Result<Bvh> bvh = build(primitives, algorithm, options);

@@ -8,7 +8,7 @@
 #include <set>
 #include <vector>
 
-#include "hbvh/build/candidates.hpp"
+#include "builders/candidates.hpp"
 #include "support/test_helpers.hpp"
 
 namespace hbvh {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <optional>
 
-#include "hbvh/build/set_partition.hpp"
+#include "builders/set_partition.hpp"
 #include "hbvh/scene/generate.hpp"
 
 namespace hbvh {

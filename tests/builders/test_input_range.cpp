@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 
 namespace hbvh {
 namespace {

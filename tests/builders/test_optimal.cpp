@@ -9,8 +9,10 @@
 #include <limits>
 #include <map>
 
-#include "hbvh/build/build.hpp"
-#include "hbvh/build/optimal.hpp"
+#include "support/test_helpers.hpp"
+#include "hbvh/builders/build.hpp"
+#include "builders/optimal_plan.hpp"
+#include "hbvh/builders/optimal.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -132,7 +134,7 @@ TEST(OptimalHierarchy, BuildEqualsEnumerationOnSmallScenes) {
             const double brute = *std::min_element(costs.begin(), costs.end());
 
             BuildReport report;
-            const Result<Bvh> bvh = build_optimal(primitives, policy, {}, &report);
+            const Result<Bvh> bvh = build_optimal(primitives, test_support::context_for(policy, &report), {});
             ASSERT_TRUE(bvh.has_value());
             EXPECT_TRUE(validate(*bvh).has_value());
             EXPECT_NEAR(tree_cost(*bvh, policy), brute, 1e-9 * brute) << "n=" << n << " seed=" << seed;
@@ -144,7 +146,7 @@ TEST(OptimalHierarchy, BuildEqualsEnumerationOnSmallScenes) {
 TEST(OptimalHierarchy, NoWorseThanAnyRegisteredBuilder) {
     for (std::uint64_t seed : {5u, 6u, 7u}) {
         const auto primitives = generate_scene({.count = 9, .seed = seed});
-        BuildOptions options;
+        BuildContext options;
         const Result<Bvh> optimal = build(primitives, Algorithm::optimal, options);
         ASSERT_TRUE(optimal.has_value());
         const double optimal_cost = tree_cost(*optimal, options.policy);
@@ -158,27 +160,27 @@ TEST(OptimalHierarchy, NoWorseThanAnyRegisteredBuilder) {
 
 TEST(OptimalHierarchy, RefusesOrFallsBackAboveTheLimitAndHandlesOnePrimitive) {
     const auto many = generate_scene({.count = 19, .seed = 1});
-    const Result<Bvh> refused = build_optimal(many, VolumePolicy::all(), {.max_primitives = 18, .fall_back = false});
+    const Result<Bvh> refused = build_optimal(many, test_support::context_for(VolumePolicy::all()), {.max_primitives = 18, .fall_back = false});
     ASSERT_FALSE(refused.has_value());
     EXPECT_NE(refused.error().message.find("at most 18"), std::string::npos);
     const auto few = generate_scene({.count = 6, .seed = 1});
     BuildReport report;
-    const Result<Bvh> fallback = build_optimal(few, VolumePolicy::all(), {.max_primitives = 4}, &report);
+    const Result<Bvh> fallback = build_optimal(few, test_support::context_for(VolumePolicy::all(), &report), {.max_primitives = 4});
     ASSERT_TRUE(fallback.has_value());  // fall_back: bnb-exact's tree, noted in the report
     EXPECT_TRUE(validate(*fallback).has_value());
     EXPECT_EQ(report.lower_bound, 0.0);
     EXPECT_FALSE(report.notes.empty());
-    EXPECT_FALSE(build_optimal(std::span<const Primitive>{}, VolumePolicy::all()).has_value());
+    EXPECT_FALSE(build_optimal(std::span<const Primitive>{}, test_support::context_for(VolumePolicy::all())).has_value());
     const auto one = generate_scene({.count = 1, .seed = 1});
-    const Result<Bvh> leaf = build_optimal(one, VolumePolicy::all());
+    const Result<Bvh> leaf = build_optimal(one, test_support::context_for(VolumePolicy::all()));
     ASSERT_TRUE(leaf.has_value());
     EXPECT_EQ(leaf->nodes.size(), 1u);
 }
 
 TEST(OptimalHierarchy, DeterministicTree) {
     const auto primitives = generate_scene({.count = 7, .seed = 12});
-    const Result<Bvh> a = build_optimal(primitives, VolumePolicy::all());
-    const Result<Bvh> b = build_optimal(primitives, VolumePolicy::all());
+    const Result<Bvh> a = build_optimal(primitives, test_support::context_for(VolumePolicy::all()));
+    const Result<Bvh> b = build_optimal(primitives, test_support::context_for(VolumePolicy::all()));
     ASSERT_TRUE(a && b);
     ASSERT_EQ(a->nodes.size(), b->nodes.size());
     for (std::size_t i = 0; i < a->nodes.size(); ++i) {

@@ -10,7 +10,7 @@
 #include <optional>
 #include <vector>
 
-#include "hbvh/build/set_partition.hpp"
+#include "builders/set_partition.hpp"
 #include "hbvh/geometry/aabb.hpp"
 #include "hbvh/scene/generate.hpp"
 

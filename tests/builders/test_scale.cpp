@@ -8,8 +8,9 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
-#include "hbvh/build/scale.hpp"
+#include "support/test_helpers.hpp"
+#include "hbvh/builders/build.hpp"
+#include "hbvh/builders/scale.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -28,7 +29,7 @@ TEST(Scale, PropertiesOnGeneratedScenes) {
             SCOPED_TRACE(std::to_string(count) + (clustered ? " clustered" : " uniform"));
             const std::vector<Primitive> primitives = generated_scene(count, 100 + count, clustered);
             BuildReport report;
-            const Bvh bvh = build_scale(primitives, VolumePolicy::all(), {}, &report);
+            const Bvh bvh = build_scale(primitives, test_support::context_for(VolumePolicy::all(), &report), {}).value();
             expect_tree_properties(primitives, bvh);
             if (count > 1) {
                 EXPECT_FALSE(report.levels.empty());
@@ -43,7 +44,7 @@ TEST(Scale, PropertiesWithRestrictedPolicies) {
     for (BvType type : all_bv_types) {
         SCOPED_TRACE(std::string(to_string(type)));
         const VolumePolicy policy = VolumePolicy::only(type);
-        const Bvh bvh = build_scale(primitives, policy);
+        const Bvh bvh = build_scale(primitives, test_support::context_for(policy)).value();
         expect_tree_properties(primitives, bvh);
         for (const Node& node : bvh.nodes)
             if (!node.is_leaf()) {
@@ -56,7 +57,7 @@ TEST(Scale, SameHierarchyForOneAndTwoThreads) {
     const std::vector<Primitive> primitives = generated_scene(3000, 42);
     const auto build_with = [&](std::size_t threads) {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-        return build_scale(primitives, VolumePolicy::all());
+        return build_scale(primitives, test_support::context_for(VolumePolicy::all())).value();
     };
     expect_identical_trees(build_with(1), build_with(2));
 }
@@ -67,7 +68,7 @@ TEST(Scale, NoWorseThanMergeAndRatioToSplitRecorded) {
     for (const auto& [count, seed] : {std::pair{1000u, 5u}, std::pair{1500u, 6u}}) {
         SCOPED_TRACE(std::to_string(count));
         const std::vector<Primitive> primitives = generated_scene(count, seed);
-        const double scale_cost = cost(build_scale(primitives, VolumePolicy::all()));
+        const double scale_cost = cost(build_scale(primitives, test_support::context_for(VolumePolicy::all())).value());
         Result<Bvh> merged = build(primitives, Algorithm::merge);
         ASSERT_TRUE(merged.has_value());
         EXPECT_LE(scale_cost, cost(merged.value()));
@@ -79,9 +80,9 @@ TEST(Scale, NoWorseThanMergeAndRatioToSplitRecorded) {
 
 TEST(Scale, ReportsProgressUpToOne) {
     std::vector<double> fractions;
-    ScaleOptions options;
-    options.progress = [&](double f) { fractions.push_back(f); };
-    (void)build_scale(generated_scene(500, 3), VolumePolicy::all(), options);
+    BuildContext context;
+    context.progress = [&](double f) { fractions.push_back(f); };
+    (void)build_scale(generated_scene(500, 3), context).value();
     ASSERT_FALSE(fractions.empty());
     for (std::size_t i = 1; i < fractions.size(); ++i) EXPECT_GE(fractions[i], fractions[i - 1]);
     EXPECT_DOUBLE_EQ(fractions.back(), 1.0);
@@ -89,10 +90,10 @@ TEST(Scale, ReportsProgressUpToOne) {
 
 TEST(Scale, TimeLimitStillGivesAValidTree) {
     const std::vector<Primitive> primitives = generated_scene(2000, 9);
-    ScaleOptions options;
-    options.time_limit_seconds = 1e-6;  // past at once: every window keeps its initial cover
     BuildReport report;
-    const Bvh bvh = build_scale(primitives, VolumePolicy::all(), options, &report);
+    // Past at once: every window keeps its initial cover.
+    const BuildContext context = test_support::context_for(VolumePolicy::all(), &report).with_time_limit(1e-6);
+    const Bvh bvh = build_scale(primitives, context).value();
     expect_tree_properties(primitives, bvh);
     EXPECT_TRUE(report.budget_hit);
 }
@@ -107,7 +108,7 @@ TEST(Auto, PicksBySizeAndSaysSo) {
     for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_exact_max_primitives + 10}) {
         const std::vector<Primitive> primitives = generated_scene(count, count);
         BuildReport report;
-        BuildOptions options;
+        BuildContext options;
         options.report = &report;
         Result<Bvh> built = build(primitives, Algorithm::automatic, options);
         ASSERT_TRUE(built.has_value());
@@ -127,9 +128,7 @@ TEST(Auto, TimeLimitSkipsTheRestOfThePortfolio) {
     const std::vector<Primitive> primitives = generated_scene(auto_insertion_max_primitives + 50, 17);
     ASSERT_EQ(auto_portfolio(primitives.size()), (std::vector<Algorithm>{Algorithm::scale, Algorithm::split}));
     BuildReport report;
-    BuildOptions options;
-    options.report = &report;
-    options.time_limit_seconds = 1e-6;
+    const BuildContext options = test_support::context_for(VolumePolicy::all(), &report).with_time_limit(1e-6);
     Result<Bvh> built = build(primitives, Algorithm::automatic, options);
     ASSERT_TRUE(built.has_value());
     expect_tree_properties(primitives, built.value());

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -29,7 +29,7 @@ constexpr Algorithm order_dependent_builders[] = {Algorithm::insertion, Algorith
 // The shared property check: every primitive in exactly one leaf, leaves carry their primitive, no inner
 // node with one child, every node's BV contains the generating spheres of every covered primitive
 // (relative tolerance 1e-9 of the node's size), and validate() agrees. Returns the built hierarchy.
-Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorithm, const BuildOptions& options = {}) {
+Bvh check_properties(const std::vector<Primitive>& primitives, Algorithm algorithm, const BuildContext& options = {}) {
     SCOPED_TRACE(std::string(to_string(algorithm)) + " over " + std::to_string(primitives.size()) + " primitives");
     Result<Bvh> built = build(primitives, algorithm, options);
     EXPECT_TRUE(built.has_value()) << (built.has_value() ? "" : built.error().to_string());
@@ -67,7 +67,7 @@ INSTANTIATE_TEST_SUITE_P(SurveyHeuristics, EveryHeuristic, testing::ValuesIn(heu
 TEST(SurveyHeuristics, PropertiesUnderRestrictedPolicies) {
     const std::vector<Primitive> primitives = generated_scene(40, 7);
     for (const BvType only : all_bv_types) {
-        BuildOptions options;
+        BuildContext options;
         options.policy = VolumePolicy::only(only);
         for (const Algorithm algorithm : heuristic_builders) {
             const Bvh bvh = check_properties(primitives, algorithm, options);
@@ -95,9 +95,13 @@ TEST(SurveyHeuristics, DegenerateInputs) {
 TEST(SurveyHeuristics, MergeBranchingFactorIsAnOption) {
     const std::vector<Primitive> primitives = generated_scene(50, 11);
     for (const std::uint32_t factor : {2u, 3u, 4u, 8u}) {
-        BuildOptions options;
-        options.merge.branching_factor = factor;
-        check_properties(primitives, Algorithm::merge, options);
+        MergeOptions options;
+        options.branching_factor = factor;
+        const Result<Bvh> built = build_merge(primitives, BuildContext{}, options);
+        ASSERT_TRUE(built.has_value()) << factor;
+        test_support::expect_tree_properties(primitives, *built);
+        // Groups get factor to 2 x factor - 2 children (merge.hpp).
+        for (const Node& node : built->nodes) EXPECT_LE(node.child_count, std::max(2u, 2 * factor - 2)) << factor;
     }
 }
 

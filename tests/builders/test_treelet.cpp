@@ -9,12 +9,13 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
-#include "hbvh/build/treelet.hpp"
+#include "hbvh/builders/build.hpp"
+#include "hbvh/builders/treelet.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/test_helpers.hpp"
 #include "support/tree_properties.hpp"
 
 namespace hbvh {
@@ -94,7 +95,7 @@ TEST(Treelet, NeverCostlierOnGeneratedScenes) {
 TEST(Treelet, RespectsThePolicy) {
     const std::vector<Primitive> primitives = generated_scene(20, 3);
     VolumePolicy spheres_only = VolumePolicy::only(BvType::sphere);
-    BuildOptions options;
+    BuildContext options;
     options.policy = spheres_only;
     Result<Bvh> built = build(primitives, Algorithm::split, options);
     ASSERT_TRUE(built.has_value());
@@ -147,12 +148,11 @@ TEST(Treelet, SameTreeForAnyThreadCount) {
 
 TEST(Treelet, RefineOptionAppliesToAnyBuilder) {
     const std::vector<Primitive> primitives = generated_scene(25, 5);
-    BuildOptions options;
     BuildReport report;
-    options.refine = true;
-    options.treelets.max_units = 5;
-    options.report = &report;
-    Result<Bvh> refined = build(primitives, Algorithm::insertion, options);
+    TreeletOptions treelets;
+    treelets.max_units = 5;
+    Result<Bvh> refined =
+        build_refined(primitives, Algorithm::insertion, test_support::context_for(VolumePolicy::all(), &report), treelets);
     ASSERT_TRUE(refined.has_value());
     EXPECT_TRUE(validate(*refined).has_value());
     EXPECT_LE(cost(*refined), cost(build_with(primitives, Algorithm::insertion)) * (1.0 + 1e-12));
@@ -164,13 +164,13 @@ TEST(Treelet, RefineOptionAppliesToAnyBuilder) {
 /// any builder can have a node smaller than `optimal`'s node over the same primitives, and `optimal`'s
 /// cost is a true lower bound. (With OBBs and capsules the fitters are heuristics and a builder that fits
 /// differently could, in principle, beat it.)
-BuildOptions exact_fit_options() {
-    BuildOptions options;
+BuildContext exact_fit_options() {
+    BuildContext options;
     options.policy.allowed = {true, false, true, false};
     return options;
 }
 
-double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm, const BuildOptions& options) {
+double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm, const BuildContext& options) {
     Result<Bvh> built = build(primitives, algorithm, options);
     EXPECT_TRUE(built.has_value()) << to_string(algorithm);
     return built.has_value() ? cost(*built, options.policy) : 0.0;
@@ -181,7 +181,7 @@ double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm, co
 // be a cost, fitting or bookkeeping error in a member, the refinement or the DP. Neither is hidden by
 // `auto` taking the minimum of its members, which the test it replaces only restated.
 TEST(Auto, EqualsTheOptimumUpToTenPrimitivesAndNeverBeatsItAbove) {
-    const BuildOptions options = exact_fit_options();
+    const BuildContext options = exact_fit_options();
     for (std::uint32_t count = 2; count <= 14; count += 2) {
         for (std::uint64_t seed : {1u, 2u}) {
             const std::vector<Primitive> primitives = generated_scene(count, 60 + 10 * seed + count);
@@ -198,7 +198,7 @@ TEST(Auto, EqualsTheOptimumUpToTenPrimitivesAndNeverBeatsItAbove) {
 }
 
 TEST(Auto, NeverBeatsTheOptimumOnSmallBundledModels) {
-    const BuildOptions options = exact_fit_options();
+    const BuildContext options = exact_fit_options();
     int checked = 0;
     for (const auto& [name, primitives] : bundled_models()) {
         if (primitives.size() > 14) continue;  // optimal's fits double per primitive
@@ -215,7 +215,7 @@ TEST(Auto, HandComputedCostOfThreeCubesInARow) {
     std::vector<Primitive> cubes;
     for (double x : {0.0, 2.0, 4.0})
         cubes.push_back(Primitive{Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, "cube"});
-    BuildOptions options;
+    BuildContext options;
     options.policy = VolumePolicy::only(BvType::aabb);
     EXPECT_NEAR(cost_of(cubes, Algorithm::automatic, options), 15.0, 1e-12);
     EXPECT_NEAR(cost_of(cubes, Algorithm::optimal, options), 15.0, 1e-12);

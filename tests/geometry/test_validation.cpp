@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 

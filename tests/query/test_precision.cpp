@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -242,8 +242,8 @@ TEST_P(PrecisionPerBuilder, RigidMotionsKeepThePairsUpToTheBand) {
 }
 
 INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, PrecisionPerBuilder, ::testing::ValuesIn(algorithms().begin(), algorithms().end()),
-                         [](const ::testing::TestParamInfo<AlgorithmInfo>& info) {
-                             std::string name(info.param.name);
+                         [](const ::testing::TestParamInfo<AlgorithmInfo>& param_info) {
+                             std::string name(param_info.param.name);
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });

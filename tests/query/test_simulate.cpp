@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/query/simulate.hpp"
 #include "hbvh/scene/generate.hpp"

@@ -7,7 +7,7 @@
 #include <string>
 
 #include "hbvh/assert.hpp"
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"

@@ -7,7 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "hbvh/build/bottom_up.hpp"
+#include "builders/bottom_up.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/scene/generate.hpp"
 
 namespace hbvh::test_support {
@@ -31,6 +32,14 @@ inline Level make_level(const std::vector<Primitive>& primitives, const VolumePo
     for (std::uint32_t p = 0; p < primitives.size(); ++p)
         nodes.push_back({primitives[p].volume, policy.weighted_volume(primitives[p].volume), {p}});
     return Level(primitives, std::move(nodes), policy);
+}
+
+/// A build context with `policy` and, optionally, a report to fill.
+inline BuildContext context_for(const VolumePolicy& policy, BuildReport* report = nullptr) {
+    BuildContext context;
+    context.policy = policy;
+    context.report = report;
+    return context;
 }
 
 }  // namespace hbvh::test_support

@@ -77,23 +77,24 @@ int run_build(const BuildArguments& args) {
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
     if (Status stored = check_stored_hierarchy(model.value(), args.builder); !stored) return report_error(stored.error());
-    Result<std::pair<Algorithm, BuildOptions>> resolved = args.builder.resolve();
-    if (!resolved) {
-        fmt::print(stderr, "hbvh build: {}\n", resolved.error().to_string());
+    Result<BuildRequest> request = args.builder.resolve();
+    if (!request) {
+        fmt::print(stderr, "hbvh build: {}\n", request.error().to_string());
         return exit_bad_usage;
     }
-    auto [algorithm, options] = resolved.value();
     BuildReport report;
-    options.report = &report;
+    request->context.report = &report;
     const auto start = std::chrono::steady_clock::now();
     bool bar_drawn = false;
-    options.progress = progress_bar(start, bar_drawn);
-    Result<Bvh> bvh = build(model->primitives, algorithm, options);
+    request->context.progress = progress_bar(start, bar_drawn);
+    const Algorithm algorithm = request->algorithm;
+    const VolumePolicy& policy = request->context.policy;
+    Result<Bvh> bvh = request->run(model->primitives);
     if (bar_drawn) fmt::print(stderr, "\n");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!bvh) return report_error(bvh.error());
     if (args.report || args.stats) {
-        const Stats stats = compute_stats(bvh.value(), options.policy);
+        const Stats stats = compute_stats(bvh.value(), policy);
         if (args.report) print_report(report, seconds, stats.cost);
         if (args.stats)
             fmt::print(stderr, "{}: {} primitives, {} nodes, height {}, cost {:.6g} ({} in {:.3f} ms); {}\n", args.input,

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "hbvh/build/build.hpp"
+#include "hbvh/builders/build.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -53,6 +53,17 @@ int report_error(const Error& error);
 /// Prints warnings to stderr, one a line.
 void report_warnings(const std::vector<std::string>& warnings);
 
+/// A builder and what steers it, as the flags chose: the deadline starts when run() does.
+struct BuildRequest {
+    Algorithm algorithm = Algorithm::automatic;
+    BuildContext context;             ///< Policy; progress and report are set by the caller.
+    double time_limit_seconds = 0.0;  ///< 0: none.
+    bool refine = false;              ///< Treelet refinement after the builder (build_refined).
+    TreeletOptions treelets;
+    /// Builds over `primitives` with the deadline counted from now.
+    [[nodiscard]] Result<Bvh> run(std::span<const Primitive> primitives) const;
+};
+
 /// Options that select and steer a builder, shared by build, stats, compare, collide.
 struct BuilderFlags {
     std::string algorithm = "auto";
@@ -65,8 +76,8 @@ struct BuilderFlags {
     void add_to(CLI::App& command);
     /// Adds --refit, for the commands that query or draw a stored hierarchy.
     void add_refit_to(CLI::App& command);
-    /// The algorithm and options, or a usage Error.
-    [[nodiscard]] Result<std::pair<Algorithm, BuildOptions>> resolve() const;
+    /// The build these flags ask for, or a usage Error.
+    [[nodiscard]] Result<BuildRequest> resolve() const;
 };
 
 /// The model's stored hierarchy once it passes validate() (with flags.refit, its non-enclosing volumes

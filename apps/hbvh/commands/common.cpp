@@ -135,7 +135,7 @@ void BuilderFlags::add_to(CLI::App& command) {
         ->check(CLI::Range(3u, 12u));
 }
 
-Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
+Result<BuildRequest> BuilderFlags::resolve() const {
     const std::optional<Algorithm> chosen = parse_algorithm(algorithm);
     if (!chosen) return Error{"unknown algorithm '" + algorithm + "' (see `hbvh algorithms`)"};
     Result<VolumePolicy> policy = parse_allowed_types(types);
@@ -144,12 +144,18 @@ Result<std::pair<Algorithm, BuildOptions>> BuilderFlags::resolve() const {
         policy = parse_type_weights(type_weights, policy.value());
         if (!policy) return policy.error();
     }
-    BuildOptions options;
-    options.policy = policy.value();
-    options.time_limit_seconds = time_limit_seconds;
-    options.refine = refine;
-    options.treelets.max_units = treelet_units;
-    return std::pair{*chosen, options};
+    BuildRequest request;
+    request.algorithm = *chosen;
+    request.context.policy = policy.value();
+    request.time_limit_seconds = time_limit_seconds;
+    request.refine = refine;
+    request.treelets.max_units = treelet_units;
+    return request;
+}
+
+Result<Bvh> BuildRequest::run(std::span<const Primitive> primitives) const {
+    const BuildContext timed = context.with_time_limit(time_limit_seconds);
+    return refine ? build_refined(primitives, algorithm, timed, treelets) : build(primitives, algorithm, timed);
 }
 
 void BuilderFlags::add_refit_to(CLI::App& command) {
@@ -199,9 +205,9 @@ Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags) {
 
 Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags) {
     if (model.hierarchy) return checked_stored_hierarchy(model, flags);
-    Result<std::pair<Algorithm, BuildOptions>> resolved = flags.resolve();
-    if (!resolved) return resolved.error();
-    return build(model.primitives, resolved->first, resolved->second);
+    Result<BuildRequest> request = flags.resolve();
+    if (!request) return request.error();
+    return request->run(model.primitives);
 }
 
 }  // namespace hbvh::cli

@@ -64,22 +64,60 @@ std::vector<std::string> split_names(const std::string& list) {
 }
 
 /// Builds `repeats` times; the median time is robust to the odd slow run on a shared machine.
-Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, BuildOptions options, int repeats) {
+/// What compare tunes beyond the flags: optimal never falls back (an `optimal` row is the optimum or an
+/// error, never bnb-exact's tree under optimal's name), and --bnb-nodes caps the survey's search.
+struct CompareSettings {
+    BuildRequest request;
+    std::uint64_t bnb_nodes = 0;
+};
+
+/// One build of `algorithm` with compare's settings; the deadline counts from now.
+Result<Bvh> build_for_compare(const std::vector<Primitive>& primitives, Algorithm algorithm,
+                              const CompareSettings& settings, BuildReport& report) {
+    BuildContext context = settings.request.context.with_time_limit(settings.request.time_limit_seconds);
+    context.report = &report;
+    switch (algorithm) {
+        case Algorithm::optimal: {
+            OptimalOptions options;
+            options.fall_back = false;
+            return build_optimal(primitives, context, options);
+        }
+        case Algorithm::bnb_tightest: {
+            BnbTightestOptions options;
+            if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
+            return build_bnb_tightest(primitives, context, options);
+        }
+        case Algorithm::bnb_enlarge: {
+            BnbEnlargeOptions options;
+            if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
+            return build_bnb_enlarge(primitives, context, options);
+        }
+        case Algorithm::bnb_exact: {
+            BnbExactOptions options;
+            if (settings.bnb_nodes > 0) options.enlarge_options.budget.max_nodes = settings.bnb_nodes;
+            return build_bnb_exact(primitives, context, options);
+        }
+        default: break;
+    }
+    return settings.request.refine ? build_refined(primitives, algorithm, context, settings.request.treelets)
+                                   : build(primitives, algorithm, context);
+}
+
+Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const CompareSettings& settings, int repeats) {
     Row row;
     row.algorithm = std::string(to_string(algorithm));
     row.primitives = primitives.size();
     std::vector<double> times;
     for (int r = 0; r < repeats; ++r) {
         BuildReport report;
-        options.report = &report;
         const auto start = std::chrono::steady_clock::now();
-        Result<Bvh> bvh = build(primitives, algorithm, options);
+        Result<Bvh> bvh = build_for_compare(primitives, algorithm, settings, report);
         times.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
         if (!bvh) {
             row.error = bvh.error().to_string();
             return row;
         }
-        const Stats stats = compute_stats(bvh.value(), options.policy);
+        const Stats stats = compute_stats(bvh.value(), settings.request.context.policy);
         row.cost = stats.cost;
         row.height = stats.height;
         row.candidates = report.total_candidates;
@@ -91,17 +129,6 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, Build
     std::sort(times.begin(), times.end());
     row.median_ms = times[times.size() / 2];
     return row;
-}
-
-/// `options` with --time-limit also given to the survey's reference branch and bound (bnb-tightest,
-/// bnb-enlarge), which the library leaves to its node budget: spread over its ~2 log2 n solver calls,
-/// as build() does for bnb-exact. scale and bnb-exact get the limit from build() itself.
-BuildOptions within_time_limit(BuildOptions options, std::size_t primitive_count) {
-    if (options.time_limit_seconds > 0.0) {
-        const double calls = 2.0 * std::max(1.0, std::log2(static_cast<double>(primitive_count)));
-        options.branch_and_bound.budget.max_seconds = options.time_limit_seconds / calls;
-    }
-    return options;
 }
 
 void print_markdown(const std::vector<Row>& rows) {
@@ -161,20 +188,14 @@ int run_compare(const CompareArguments& args) {
             chosen.push_back(*algorithm);
         }
     }
-    Result<std::pair<Algorithm, BuildOptions>> resolved = args.builder.resolve();
+    Result<BuildRequest> resolved = args.builder.resolve();
     if (!resolved) {
         fmt::print(stderr, "hbvh compare: {}\n", resolved.error().to_string());
         return exit_bad_usage;
     }
-    BuildOptions options = resolved->second;
-    // An `optimal` row is the optimum or an error, never bnb-exact's tree under optimal's name.
-    options.optimal.fall_back = false;
-    if (args.bnb_nodes > 0) {
-        options.branch_and_bound.budget.max_nodes = args.bnb_nodes;
-        options.bnb_exact.enlarge_options.budget.max_nodes = args.bnb_nodes;
-    }
+    const CompareSettings settings{resolved.value(), args.bnb_nodes};
     const std::uint32_t optimum_limit =
-        std::min({args.optimum_max_primitives, options.optimal.max_primitives, optimal_hard_limit});
+        std::min({args.optimum_max_primitives, OptimalOptions{}.max_primitives, optimal_hard_limit});
     std::vector<Row> rows;
     for (const std::string& input : args.inputs) {
         Result<Model> model = load_model(input);
@@ -183,8 +204,7 @@ int run_compare(const CompareArguments& args) {
         const std::size_t count = model->primitives.size();
         const std::string name = std::filesystem::path(input).stem().string();
         fmt::print(stderr, "hbvh compare: {} ({} primitives)\n", name, count);
-        const BuildOptions model_options = within_time_limit(options, count);
-        const double baseline = measure(model->primitives, Algorithm::two_level, model_options, 1).cost;
+        const double baseline = measure(model->primitives, Algorithm::two_level, settings, 1).cost;
         const std::size_t first = rows.size();
         for (Algorithm algorithm : chosen) {
             Row row;
@@ -194,7 +214,7 @@ int run_compare(const CompareArguments& args) {
                 row.primitives = count;
                 row.error = fmt::format("skipped: {} primitives > {} (optimum limit)", count, optimum_limit);
             } else {
-                row = measure(model->primitives, algorithm, model_options, args.repeats);
+                row = measure(model->primitives, algorithm, settings, args.repeats);
             }
             row.model = name;
             row.relative = baseline > 0.0 ? row.cost / baseline : 1.0;
@@ -204,7 +224,7 @@ int run_compare(const CompareArguments& args) {
         std::optional<double> optimum;
         if (count <= optimum_limit) {
             for (std::size_t i = first; i < rows.size() && !optimum; ++i) optimum = rows[i].optimum;
-            if (!optimum) optimum = measure(model->primitives, Algorithm::optimal, model_options, 1).optimum;
+            if (!optimum) optimum = measure(model->primitives, Algorithm::optimal, settings, 1).optimum;
         }
         if (optimum && *optimum > 0.0)
             for (std::size_t i = first; i < rows.size(); ++i)

@@ -4,13 +4,13 @@
 
 #include <span>
 
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
 
-/// Knobs of build_incremental_insert (none yet; kept for the common builder shape, STYLE.md §3).
+/// Knobs of build_insertion (none yet; kept for the common builder shape, STYLE.md §3).
 struct InsertionOptions {};
 
 /// Inserts the primitives in input order. Each one descends a single path from the root, at every group
@@ -19,8 +19,8 @@ struct InsertionOptions {};
 /// (ties: nearest centre). The cheapest rule seen on the path wins (Haines' refinement). Candidate
 /// volumes are estimated by fit_best around the node's BV and p; after the insertion every BV on the
 /// path is refit exactly (fit_best over the covered primitives). The result depends on input order,
-/// as the survey notes. Error: empty input.
-[[nodiscard]] Result<Bvh> build_incremental_insert(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                                   const InsertionOptions& options = {});
+/// as the survey notes. Deadline: checked between insertions.
+[[nodiscard]] Result<Bvh> build_insertion(std::span<const Primitive> primitives, const BuildContext& context,
+                                          const InsertionOptions& options = {});
 
 }  // namespace hbvh

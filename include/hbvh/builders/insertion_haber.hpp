@@ -5,14 +5,14 @@
 #include <cstdint>
 #include <span>
 
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
 
-/// Knobs of build_incremental_insert_haber. See docs/algorithms-heuristics.md.
-struct HaberInsertionOptions {
+/// Knobs of build_insertion_haber. See docs/algorithms-heuristics.md.
+struct InsertionHaberOptions {
     /// Rule 4: p may form a new group with up to this many children of a group g (2 or more).
     std::uint32_t max_rule4_children = 6;
     /// Rounds of global optimisation (Successive Re-Insertion, then Elimination of Ill-formed Groups);
@@ -34,9 +34,9 @@ struct HaberInsertionOptions {
 /// group), then improves the tree globally: Successive Re-Insertion removes badly placed leaves and
 /// inserts them again; Elimination of Ill-formed Groups dissolves groups that fail the badness criteria
 /// and re-inserts their children. Every global step is kept only if it lowers the cost. Depends on input
-/// order (less than build_incremental_insert). Error: empty input.
-[[nodiscard]] Result<Bvh> build_incremental_insert_haber(std::span<const Primitive> primitives,
-                                                         const VolumePolicy& policy,
-                                                         const HaberInsertionOptions& options = {});
+/// order (less than build_insertion). Deadline: checked between insertions (the two-level tree if it
+/// passes there) and between optimisation rounds (the tree as optimised so far).
+[[nodiscard]] Result<Bvh> build_insertion_haber(std::span<const Primitive> primitives, const BuildContext& context,
+                                                const InsertionHaberOptions& options = {});
 
 }  // namespace hbvh

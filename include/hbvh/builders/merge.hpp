@@ -5,13 +5,13 @@
 #include <cstdint>
 #include <span>
 
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
 
-/// Knobs of build_bottom_up_merge. See docs/algorithms-heuristics.md.
+/// Knobs of build_merge. See docs/algorithms-heuristics.md.
 struct MergeOptions {
     /// Merge postponement (survey §2.3): a collapse becomes a BVH group only once the graph-node covers at
     /// least this many BVH nodes, or fewer edges than this remain; otherwise the graph-node carries the
@@ -37,8 +37,9 @@ struct MergeOptions {
 /// overlaps; the edge with the smallest Eq. 3 priority (weighted volume of a BV fitted around both nodes'
 /// covered primitives minus both nodes' volumes) is collapsed first. When the graph runs out of edges
 /// with more than one graph-node left, the remaining graph-nodes are connected again by the same
-/// enlargement rule. The cost does not depend on the order of `primitives`. Error: empty input.
-[[nodiscard]] Result<Bvh> build_bottom_up_merge(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                                const MergeOptions& options = {});
+/// enlargement rule. The cost does not depend on the order of `primitives`. Deadline: checked between
+/// collapses.
+[[nodiscard]] Result<Bvh> build_merge(std::span<const Primitive> primitives, const BuildContext& context,
+                                      const MergeOptions& options = {});
 
 }  // namespace hbvh

@@ -4,13 +4,13 @@
 
 #include <span>
 
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
 
-/// Knobs of build_obb_tree.
+/// Knobs of build_obbtree.
 struct ObbTreeOptions {
     /// true: every inner node gets the covariance OBB, as in the original OBB-tree (the policy is then
     /// ignored for inner nodes). false (default): the covariance OBB only chooses the split; the node BV
@@ -22,8 +22,8 @@ struct ObbTreeOptions {
 /// its longest axis at the mean of the primitives' centres (projected), assigning each primitive by the
 /// side of its centre. If one side is empty, the other two axes are tried (longest first), then a median
 /// cut along the longest axis. Recursion stops at single primitives.
-/// The cost does not depend on the order of `primitives`. Error: empty input.
-[[nodiscard]] Result<Bvh> build_obb_tree(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                         const ObbTreeOptions& options = {});
+/// The cost does not depend on the order of `primitives`. Deadline: checked at every node.
+[[nodiscard]] Result<Bvh> build_obbtree(std::span<const Primitive> primitives, const BuildContext& context,
+                                        const ObbTreeOptions& options = {});
 
 }  // namespace hbvh

@@ -6,10 +6,8 @@
 
 #include <cstdint>
 #include <span>
-#include <vector>
 
-#include "hbvh/build/report.hpp"
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
@@ -29,34 +27,14 @@ struct OptimalOptions {
     bool fall_back = true;
 };
 
-/// One inner node of an optimal hierarchy: the primitives it covers and its children's, as bit masks
-/// over the input indices (bit i = primitive i). A child with one bit set is a leaf.
-struct OptimalGroup {
-    std::uint32_t covered = 0;
-    std::vector<std::uint32_t> children;
-};
-
-/// The DP's answer: groups root first (parents before children), and the optimal Eq. 2 cost.
-struct OptimalPlan {
-    std::vector<OptimalGroup> groups;
-    double cost = 0.0;
-};
-
-/// The DP core on an abstract volume function: `subset_volume[mask]` is the (weighted) volume of the BV
-/// of the primitives in `mask`, for every mask of `count` bits (entries of masks with fewer than two bits
-/// are ignored). Returns the tree minimising Eq. 2 — sum over inner nodes of children x volume — over
-/// ALL rooted trees with `count` labelled leaves, any branching factor >= 2; leaves cost nothing.
-/// Ties are broken deterministically. Preconditions: 1 <= count <= optimal_hard_limit,
-/// subset_volume.size() == 2^count, volumes finite.
-[[nodiscard]] OptimalPlan solve_optimal_hierarchy(std::uint32_t count, std::span<const double> subset_volume);
-
 /// The optimal hierarchy over `primitives`: optimal over all trees whose inner-node BVs are
 /// fit_best(covered primitives) under `policy` (fitting input as FitInput over the covered primitives in
 /// input order, as build_two_level does). Subset volumes are fitted in parallel with TBB; the result does
 /// not depend on the thread count. Error when there are no primitives, or more than
 /// options.max_primitives with fall_back off (with it on: bnb-exact's tree, not proven optimal). `report`, when non-null, gets one level entry and the proven optimum as lower
-/// bound.
-[[nodiscard]] Result<Bvh> build_optimal(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                        const OptimalOptions& options = {}, BuildReport* report = nullptr);
+/// bound. Deadline: checked while the subset volumes are fitted and before the DP (the two-level tree
+/// once it passes).
+[[nodiscard]] Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildContext& context,
+                                        const OptimalOptions& options = {});
 
 }  // namespace hbvh

@@ -3,12 +3,11 @@
 #pragma once
 
 #include <cstdint>
-#include <functional>
 #include <span>
 
-#include "hbvh/build/report.hpp"
-#include "hbvh/build/set_partition.hpp"
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/budget.hpp"
+#include "hbvh/builders/context.hpp"
+#include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
@@ -37,12 +36,6 @@ struct ScaleOptions {
     std::uint32_t exact_fit_level_max_input = 50'000;
     /// Per window solve_exact budget. A node limit, unlike a time limit, keeps the result deterministic.
     SolverBudget window_budget{20'000, 0.0};
-    /// Whole-build wall-clock limit in seconds (0: none). Once passed, the remaining windows keep the
-    /// solver's initial (greedy + local search) cover instead of searching; the result then depends on
-    /// timing and BuildReport::budget_hit is set.
-    double time_limit_seconds = 0.0;
-    /// Called after every level with the fraction of the work done (0..1], from the calling thread.
-    std::function<void(double fraction)> progress;
 };
 
 /// The scale builder: level by level bottom-up. Each level is sorted along a Morton curve of the node
@@ -53,22 +46,10 @@ struct ScaleOptions {
 /// TBB and write to their own slots, combined in window order: the hierarchy is the same for any thread
 /// count (unless time_limit_seconds cuts the search). Every inner node has 2..max_group_size children and
 /// its BV encloses the generating spheres of all covered primitives. Precondition: primitives non-empty.
-/// `report`, when non-null, gets one row per level; lower_bound stays 0 (no global bound is known).
-[[nodiscard]] Bvh build_scale(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                              const ScaleOptions& options = {}, BuildReport* report = nullptr);
-
-/// The cheap enclosing fitter used for big groups: the smallest weighted volume, over the allowed kinds,
-/// of the exact AABB, the exact sphere, OBBs in the world frame, the principal frame of the centres and
-/// the frames of any boxes among `hints`, and capsules on the principal axis and on the axes of any
-/// capsules among `hints`. Every result contains all `spheres`. Precondition: spheres non-empty.
-[[nodiscard]] BoundingVolume fit_fast(std::span<const Sphere> spheres, std::span<const BoundingVolume> hints,
-                                      const VolumePolicy& policy);
-
-/// How fit_fast fits the sphere: exactly (CGAL's minimum sphere), or quickly around the better of the
-/// box centre and the mean centre (encloses as surely, a little larger; for pricing candidates).
-enum class FastFitMode { exact_sphere, quick_sphere };
-/// fit_fast with a choice of sphere fitter.
-[[nodiscard]] BoundingVolume fit_fast(std::span<const Sphere> spheres, std::span<const BoundingVolume> hints,
-                                      const VolumePolicy& policy, FastFitMode mode);
+/// The report gets one row per level; lower_bound stays 0 (no global bound is known). Deadline: anytime —
+/// once passed, the remaining windows keep the solver's initial (greedy + local search) cover instead of
+/// searching; the result then depends on timing and BuildReport::budget_hit is set. Progress: per level.
+[[nodiscard]] Result<Bvh> build_scale(std::span<const Primitive> primitives, const BuildContext& context,
+                                      const ScaleOptions& options = {});
 
 }  // namespace hbvh

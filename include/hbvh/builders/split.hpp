@@ -5,13 +5,13 @@
 #include <cstdint>
 #include <span>
 
-#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/builders/context.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
 
-/// Knobs of build_top_down_split. See docs/algorithms-heuristics.md.
+/// Knobs of build_split. See docs/algorithms-heuristics.md.
 struct SplitOptions {
     /// Nodes with at most this many primitives price each side of each cut with the pricing fitter
     /// around that side alone (exact AABB and sphere, OBB and capsule in the side's own principal frame);
@@ -25,8 +25,8 @@ struct SplitOptions {
 /// `count(left) x volume(left) + count(right) x volume(right)` (weighted volumes), and the cheapest cut
 /// wins; recursion stops at single primitives. Node BVs are fit_best over the covered primitives.
 /// The cost of the result does not depend on the order of `primitives` (ties break on geometry).
-/// Error: empty input.
-[[nodiscard]] Result<Bvh> build_top_down_split(std::span<const Primitive> primitives, const VolumePolicy& policy,
-                                               const SplitOptions& options = {});
+/// Deadline: checked at every node; progress: the share of primitives placed.
+[[nodiscard]] Result<Bvh> build_split(std::span<const Primitive> primitives, const BuildContext& context,
+                                      const SplitOptions& options = {});
 
 }  // namespace hbvh

@@ -10,9 +10,9 @@
 #include <limits>
 #include <optional>
 
-#include "../fit/frames.hpp"
+#include "frames.hpp"
 #include "hbvh/assert.hpp"
-#include "hbvh/build/scale.hpp"
+#include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {

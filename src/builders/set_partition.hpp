@@ -3,6 +3,8 @@
 // node of a level exactly once at minimum total cost.
 #pragma once
 
+#include "hbvh/builders/budget.hpp"
+
 #include <cstdint>
 #include <optional>
 #include <vector>
@@ -16,10 +18,6 @@ struct Candidate {
 };
 
 /// Limits for a solver; 0 means unlimited.
-struct SolverBudget {
-    std::uint64_t max_nodes = 0;   ///< Search-tree nodes.
-    double max_seconds = 0.0;
-};
 
 /// A solver's answer: indices into the candidate list, ascending.
 struct Partition {

@@ -2,10 +2,12 @@
 // The survey's two merging-candidate heuristics (§3): Tightest (Fig. 10) and Enlarge (Fig. 11).
 #pragma once
 
+#include "hbvh/builders/bnb_enlarge.hpp"
+
 #include <cstdint>
 #include <vector>
 
-#include "hbvh/build/bottom_up.hpp"
+#include "bottom_up.hpp"
 
 namespace hbvh {
 
@@ -16,14 +18,6 @@ namespace hbvh {
 /// set is returned once; at most n (n - 1) sets and O(n^3) group fits, memoised by `level`.
 [[nodiscard]] std::vector<std::vector<std::uint32_t>> tightest_candidates(const Level& level);
 
-/// Knobs of B&B-Enlarge's heuristic; the defaults are the survey's.
-struct EnlargeOptions {
-    double step = 0.05;                  ///< Growth per step as a fraction of the original size (survey: 5 %).
-    std::uint32_t min_collisions = 1;    ///< Enlarge until this many other nodes collide (survey: 1).
-    std::uint32_t max_colliders = 0;     ///< Keep only the first this many colliders (earliest step, then
-                                         ///< nearest centre); 0 keeps all, as the survey does.
-    std::uint32_t max_steps = 100000;    ///< Hard cap on the steps, for BVs that never span the level.
-};
 
 /// B&B-Enlarge's heuristic (§3, Fig. 11). Node i's BV B is scaled about its centre by s_k = 1 + k step,
 /// k = 0, 1, 2, ... (k = 0 is B itself) until it overlaps (exact test, geometry/overlap.hpp) at least

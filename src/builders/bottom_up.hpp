@@ -10,8 +10,9 @@
 #include <span>
 #include <vector>
 
-#include "hbvh/build/report.hpp"
-#include "hbvh/build/set_partition.hpp"
+#include "guarded_build.hpp"
+#include "hbvh/builders/report.hpp"
+#include "set_partition.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/tree/bvh.hpp"
@@ -94,6 +95,8 @@ using LevelSolver = std::function<std::optional<Partition>(std::uint32_t node_co
 struct BottomUpOptions {
     SolverBudget budget;             ///< Per solver call (each level, each fallback stage).
     BuildReport* report = nullptr;   ///< Filled (levels appended) when non-null.
+    /// Between levels: the deadline (throws detail::DeadlinePassed) and progress. Null: neither.
+    const detail::Checkpoint* checkpoint = nullptr;
 };
 
 /// Algorithm 1: merge the primitives level by level until one node remains. On each level `generate`

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// auto: the default builder — optimal for the smallest inputs, the cheapest of a size-dependent portfolio of
+// the other builders above, then treelet refinement (docs/treelets.md).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "hbvh/builders/context.hpp"
+#include "hbvh/builders/registry.hpp"
+#include "hbvh/builders/treelet.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+/// Input sizes at which `auto` changes strategy (auto_portfolio). Up to auto_optimal_max_primitives: the
+/// optimal subset DP alone (~1 s at 10 primitives, doubling per primitive). Up to
+/// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge and scale
+/// (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
+/// none wins everywhere, docs/results.md §1). Up to auto_insertion_max_primitives: the cheapest of scale,
+/// insertion-haber, insertion and split; up to auto_portfolio_max_primitives: of scale and split (at 1000
+/// primitives the insertions took 5-7 s, split 0.2 s, scale 0.15 s; at 20 000 split 3.4 s and 1.6x cheaper
+/// than scale, 1.3 s). Above: scale alone (docs/scale.md §5).
+/// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
+/// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
+inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
+inline constexpr std::uint32_t auto_exact_max_primitives = 24;
+inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
+inline constexpr std::uint32_t auto_portfolio_max_primitives = 20'000;
+inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
+inline constexpr std::uint32_t auto_refine_max_primitives = 200;
+
+/// Knobs of build_auto.
+struct AutoOptions {
+    /// Refine the winner at any size, not only up to auto_refine_max_primitives (CLI --refine).
+    bool refine_always = false;
+    TreeletOptions treelets;  ///< For the refinements (their time limit: what the members left).
+};
+
+/// The builders `auto` tries for `primitive_count` primitives, in tie-break order (the first wins ties).
+[[nodiscard]] std::vector<Algorithm> auto_portfolio(std::size_t primitive_count);
+/// The first member of auto_portfolio(primitive_count).
+[[nodiscard]] Algorithm auto_choice(std::size_t primitive_count);
+
+/// Every member of auto_portfolio(n) builds a tree (through the registry, with its default options) and
+/// the cheapest under Eq. 2 wins (first on ties). Deadline: the members share it — each gets what is
+/// left, and those that would start after it are skipped (the first always runs) — and refinement gets
+/// what remains, stopping between treelets.
+[[nodiscard]] Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildContext& context,
+                                     const AutoOptions& options = {});
+
+}  // namespace hbvh
