@@ -26,14 +26,16 @@ done
 
 # The umbrella header names every installed public header (so that a new header cannot be forgotten there).
 (cd "$prefix/include" && find hbvh -name '*.hpp' ! -name hbvh.hpp) | sort | while read -r header; do
-  grep -q "^#include <$header>" "$prefix/include/hbvh/hbvh.hpp" || fail "include/hbvh/hbvh.hpp does not include <$header>"
+  grep -q "^#include <$header>" "$prefix/include/hbvh/hbvh.hpp" ||
+    fail "include/hbvh/hbvh.hpp does not include <$header>"
 done
 
 # The consumers use the compiler (and compiler launcher, e.g. ccache) of the hbvh build they link against.
 cache_value() { sed -n "s/^$1:[A-Z]*=//p" "$build/CMakeCache.txt"; }
 generator=()
 command -v ninja >/dev/null 2>&1 && generator=(-G Ninja)
-configure_args=(-DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER="$(cache_value CMAKE_CXX_COMPILER)")
+configure_args=(-DCMAKE_PREFIX_PATH="$prefix" -DCMAKE_BUILD_TYPE=Release
+                -DCMAKE_CXX_COMPILER="$(cache_value CMAKE_CXX_COMPILER)")
 launcher="$(cache_value CMAKE_CXX_COMPILER_LAUNCHER)"
 [ -z "$launcher" ] || configure_args+=(-DCMAKE_CXX_COMPILER_LAUNCHER="$launcher")
 
