@@ -56,10 +56,20 @@ LevelSolver exact_level_solver() {
               const SolverBudget& budget) { return solve_exact(node_count, candidates, budget); };
 }
 
+namespace {
+/// The solvers may finish their (small) budgets without noticing that the deadline passed; the tree is
+/// then the best found in the time there was, which the report must say.
+void note_if_late(const BuildContext& context) {
+    if (context.expired())
+        context.note_deadline("bnb-exact: the time limit passed during the build; each level kept the best "
+                              "partition its solver found in its share");
+}
+}  // namespace
+
 Result<Bvh> build_bnb_exact(std::span<const Primitive> primitives, const BuildContext& context,
                             const BnbExactOptions& options) {
-    // The deadline becomes solver budgets (so levels always complete with the best partition found);
-    // the checkpoint only reports progress.
+    // The deadline becomes solver budgets, and once it has passed the driver puts one root over the levels
+    // built so far (so the guard's checkpoint never throws: it gets no deadline and only reports progress).
     BuildContext progress_only = context;
     progress_only.deadline = BuildContext::Clock::time_point::max();
     return detail::guarded_build(primitives, progress_only, "bnb-exact", static_cast<double>(primitives.size()),
@@ -72,14 +82,20 @@ Result<Bvh> build_bnb_exact(std::span<const Primitive> primitives, const BuildCo
             within.enlarge_options.budget.max_seconds = 0.5 * share;
         }
         const std::uint32_t k = within.nearest_neighbours;
-        BuildReport* report = context.report;
+        // The driver's checkpoint: the real deadline (for its anytime root), this guard's progress.
+        BuildContext level_context = context;
         BuildReport exact_report;
+        level_context.report = context.report != nullptr ? &exact_report : nullptr;
+        const detail::Checkpoint levels(level_context, static_cast<double>(primitives.size()));
+        (void)checkpoint;
+        BuildReport* report = context.report;
         Bvh exact = build_bottom_up(
             primitives, context.policy, [k](const Level& level) { return rich_candidates(level, k); },
-            exact_level_solver(), {within.budget, report != nullptr ? &exact_report : nullptr, &checkpoint});
+            exact_level_solver(), {within.budget, report != nullptr ? &exact_report : nullptr, &levels});
         if (within.guarantee_enlarge) {
             BuildReport enlarge_report;
             BuildContext enlarge_context = progress_only;
+            enlarge_context.deadline = context.deadline;
             enlarge_context.report = report != nullptr ? &enlarge_report : nullptr;
             enlarge_context.progress = nullptr;
             Result<Bvh> enlarge = build_bnb_enlarge(primitives, enlarge_context, within.enlarge_options);
@@ -89,10 +105,12 @@ Result<Bvh> build_bnb_exact(std::span<const Primitive> primitives, const BuildCo
                     *report = std::move(enlarge_report);
                     report->notes.push_back("bnb-exact: bnb-enlarge's tree was cheaper and is returned");
                 }
+                note_if_late(context);
                 return enlarge;
             }
         }
         if (report != nullptr) *report = std::move(exact_report);
+        note_if_late(context);
         return Result<Bvh>(std::move(exact));
     });
 }

@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "hbvh/assert.hpp"
+#include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
 namespace {
@@ -190,7 +191,18 @@ Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& p
     std::uint32_t level_index = 0;
     const double primitive_count = static_cast<double>(primitives.size());
     while (nodes.size() > 1) {
-        if (options.checkpoint != nullptr) options.checkpoint->step(primitive_count - static_cast<double>(nodes.size()));
+        // Anytime: once the deadline has passed, the levels built so far stay and one root takes the rest.
+        if (options.checkpoint != nullptr && options.checkpoint->context().expired()) {
+            FitInput input;
+            for (const LevelNode& node : nodes)
+                for (std::uint32_t p : node.primitives) input.add(primitives[p].volume);
+            const std::uint32_t root = assembler.add_group(ids, fit_best(input.spheres, policy, input.hint_axes));
+            options.checkpoint->context().note_deadline(
+                "time limit reached after " + std::to_string(level_index) + " levels; one root over the " +
+                std::to_string(nodes.size()) + " nodes left");
+            return std::move(assembler).finish(root);
+        }
+        if (options.checkpoint != nullptr) options.checkpoint->report(primitive_count - static_cast<double>(nodes.size()));
         const auto start = std::chrono::steady_clock::now();
         const Level level(primitives, std::move(nodes), policy);
         const std::uint32_t n = level.size();

@@ -95,7 +95,8 @@ using LevelSolver = std::function<std::optional<Partition>(std::uint32_t node_co
 struct BottomUpOptions {
     SolverBudget budget;             ///< Per solver call (each level, each fallback stage).
     BuildReport* report = nullptr;   ///< Filled (levels appended) when non-null.
-    /// Between levels: the deadline (throws detail::DeadlinePassed) and progress. Null: neither.
+    /// Between levels: progress, and the deadline — once it has passed, one root over the nodes left (the
+    /// levels built so far are kept). Null: neither.
     const detail::Checkpoint* checkpoint = nullptr;
 };
 

@@ -32,6 +32,10 @@ public:
         if (context_.expired()) throw DeadlinePassed{};
         if (context_.progress && std::this_thread::get_id() == caller_) context_.progress(done / total_);
     }
+    /// Reports done / total without looking at the deadline (for builders that handle it themselves).
+    void report(double done) const {
+        if (context_.progress && std::this_thread::get_id() == caller_) context_.progress(done / total_);
+    }
     [[nodiscard]] const BuildContext& context() const { return context_; }
 
 private:

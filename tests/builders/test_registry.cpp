@@ -1,0 +1,93 @@
+// SPDX-License-Identifier: MIT
+// The registry as one table: every row's function is what build() runs, and every builder honours the
+// deadline and the progress callback of its BuildContext (issue 12 §2), walked over the table so that a new
+// builder is checked without a line here.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "hbvh/builders/build.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/stats.hpp"
+#include "support/tree_properties.hpp"
+
+namespace hbvh {
+namespace {
+
+// 9 primitives: optimal and bnb-exact stay fast under the sanitizers.
+std::vector<Primitive> small_scene() { return generate_scene({.count = 9, .seed = 41}); }
+
+TEST(Registry, NamesAreUniqueAndRoundTrip) {
+    std::set<std::string_view> names;
+    for (const AlgorithmInfo& row : algorithms()) {
+        EXPECT_TRUE(names.insert(row.name).second) << row.name;
+        EXPECT_EQ(parse_algorithm(row.name), row.algorithm) << row.name;
+        EXPECT_EQ(to_string(row.algorithm), row.name);
+        EXPECT_EQ(&algorithm_info(row.algorithm), &row);
+        EXPECT_FALSE(row.summary.empty()) << row.name;
+        EXPECT_NE(row.build, nullptr) << row.name;
+    }
+    EXPECT_FALSE(parse_algorithm("no-such-builder").has_value());
+}
+
+TEST(Registry, EachRowsFunctionIsWhatBuildRuns) {
+    const std::vector<Primitive> primitives = small_scene();
+    for (const AlgorithmInfo& row : algorithms()) {
+        const Result<Bvh> direct = row.build(primitives, BuildContext{});
+        const Result<Bvh> through_build = build(primitives, row.algorithm);
+        ASSERT_TRUE(direct && through_build) << row.name;
+        EXPECT_EQ(cost(*direct), cost(*through_build)) << row.name;
+        EXPECT_EQ(direct->nodes.size(), through_build->nodes.size()) << row.name;
+    }
+}
+
+TEST(Registry, EveryBuilderReportsProgressUpToOne) {
+    const std::vector<Primitive> primitives = small_scene();
+    for (const AlgorithmInfo& row : algorithms()) {
+        std::vector<double> fractions;
+        BuildContext context;
+        context.progress = [&](double fraction) { fractions.push_back(fraction); };
+        const Result<Bvh> built = build(primitives, row.algorithm, context);
+        ASSERT_TRUE(built.has_value()) << row.name;
+        ASSERT_FALSE(fractions.empty()) << row.name << " never reported progress";
+        for (const double f : fractions) {
+            EXPECT_GE(f, 0.0) << row.name;
+            EXPECT_LE(f, 1.0) << row.name;
+        }
+        EXPECT_EQ(fractions.back(), 1.0) << row.name;
+    }
+}
+
+TEST(Registry, EveryBuilderHonoursAPassedDeadlineWithAValidTree) {
+    // A deadline that has passed before the build starts: each builder must stop at its first check and
+    // still return a tree over every primitive, and say in the report that the time limit cut it short.
+    // 30: above optimal's fall-back and bnb-exact's range in auto, so their deadline paths run too.
+    const std::vector<Primitive> primitives = generate_scene({.count = 30, .seed = 43});
+    for (const AlgorithmInfo& row : algorithms()) {
+        BuildReport report;
+        BuildContext context;
+        context.report = &report;
+        context.deadline = BuildContext::Clock::now() - std::chrono::seconds(1);
+        const Result<Bvh> built = build(primitives, row.algorithm, context);
+        ASSERT_TRUE(built.has_value()) << row.name << ": " << built.error().to_string();
+        test_support::expect_tree_properties(primitives, *built);
+        EXPECT_TRUE(report.budget_hit) << row.name << " did not report the passed deadline";
+    }
+}
+
+TEST(Registry, EveryBuilderRefusesBadInputTheSameWay) {
+    std::vector<Primitive> primitives = small_scene();
+    primitives[5].volume = Sphere{Vec3(0, 0, 0), -2.0};
+    for (const AlgorithmInfo& row : algorithms()) {
+        const Result<Bvh> refused = row.build(primitives, BuildContext{});
+        ASSERT_FALSE(refused.has_value()) << row.name;
+        EXPECT_NE(refused.error().message.find("primitive 5"), std::string::npos) << refused.error().message;
+        EXPECT_FALSE(row.build({}, BuildContext{}).has_value()) << row.name << " accepted an empty input";
+    }
+}
+
+}  // namespace
+}  // namespace hbvh
