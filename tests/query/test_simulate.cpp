@@ -10,6 +10,7 @@
 
 #include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
+#include "hbvh/tree/stats.hpp"
 #include "hbvh/query/simulate.hpp"
 #include "hbvh/scene/generate.hpp"
 
@@ -20,19 +21,10 @@ namespace {
 constexpr Algorithm multi_level_builders[] = {Algorithm::split, Algorithm::insertion, Algorithm::merge,
                                               Algorithm::bnb_exact, Algorithm::scale};
 
-/// Edges on the longest root-to-leaf path below node `index`.
-std::uint32_t height_below(const Bvh& bvh, std::uint32_t index) {
-    const Node& node = bvh.nodes[index];
-    std::uint32_t height = 0;
-    for (std::uint32_t c = 0; c < node.child_count; ++c)
-        height = std::max(height, 1 + height_below(bvh, node.first_child + c));
-    return height;
-}
-
 Bvh make_object(std::uint32_t count, Algorithm algorithm) {
     const auto primitives = generate_scene({.count = count, .seed = 11});
     Bvh bvh = build(primitives, algorithm).value();
-    EXPECT_GE(height_below(bvh, 0), 2u) << to_string(algorithm);
+    EXPECT_GE(compute_stats(bvh).height, 2u) << to_string(algorithm);
     return bvh;
 }
 

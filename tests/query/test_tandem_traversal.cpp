@@ -9,6 +9,7 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
+#include "hbvh/tree/stats.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
 
@@ -217,15 +218,6 @@ TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
     EXPECT_LT(work.primitive_tests, work.primitive_pairs / 2);
 }
 
-/// Edges on the longest root-to-leaf path below node `index`, counted here rather than by the library.
-std::uint32_t height_below(const Bvh& bvh, std::uint32_t index) {
-    const Node& node = bvh.nodes[index];
-    std::uint32_t height = 0;
-    for (std::uint32_t c = 0; c < node.child_count; ++c)
-        height = std::max(height, 1 + height_below(bvh, node.first_child + c));
-    return height;
-}
-
 /// Every primitive pair, both primitives moved to the world by their own object's pose: the definition of
 /// the answer, independent of relative_transform and of the query's frame.
 Pairs world_brute_force(const Bvh& a, const RigidTransform& pose_a, const Bvh& b, const RigidTransform& pose_b) {
@@ -248,8 +240,8 @@ TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {
         const std::string name(to_string(algorithm));
         const Bvh bvh = build(prims, algorithm).value();
         const Bvh other = build(others, algorithm).value();
-        ASSERT_GE(height_below(bvh, 0), 2u) << name;
-        ASSERT_GE(height_below(other, 0), 2u) << name;
+        ASSERT_GE(compute_stats(bvh).height, 2u) << name;
+        ASSERT_GE(compute_stats(other).height, 2u) << name;
         const RigidTransform pose = RigidTransform::identity();
         // Identical poses: every primitive touches at least itself.
         const CollideResult r = collide(bvh, pose, bvh, pose, CollideMode::all);

@@ -17,12 +17,12 @@
 namespace hbvh {
 namespace {
 
-Primitive unit_box_at(double x) { return {Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, "box"}; }
+Primitive structure_box_at(double x) { return {Aabb{Vec3(x, 0, 0), Vec3(x + 1, 1, 1)}, "box"}; }
 
 /// Four unit boxes grouped ((0,1),(2,3)), laid out by hand: 0 root, 1-2 groups, 3-6 leaves.
-Bvh two_pairs() {
+Bvh hand_laid_pairs() {
     Bvh bvh;
-    for (int i = 0; i < 4; ++i) bvh.primitives.push_back(unit_box_at(2.0 * i));
+    for (int i = 0; i < 4; ++i) bvh.primitives.push_back(structure_box_at(2.0 * i));
     bvh.nodes.push_back({Aabb{Vec3(0, 0, 0), Vec3(7, 1, 1)}, 1, 2, 0});
     bvh.nodes.push_back({Aabb{Vec3(0, 0, 0), Vec3(3, 1, 1)}, 3, 2, 0});
     bvh.nodes.push_back({Aabb{Vec3(4, 0, 0), Vec3(7, 1, 1)}, 5, 2, 0});
@@ -40,16 +40,16 @@ std::string structure_problem(const Bvh& bvh) {
     return status ? std::string{} : status.error().message;
 }
 
-TEST(CheckStructure, AcceptsAHandLaidBreadthFirstTree) { EXPECT_EQ(structure_problem(two_pairs()), ""); }
+TEST(CheckStructure, AcceptsAHandLaidBreadthFirstTree) { EXPECT_EQ(structure_problem(hand_laid_pairs()), ""); }
 
 TEST(CheckStructure, RefusesChildRangesPastTheEndWithoutReadingThem) {
-    Bvh bvh = two_pairs();
+    Bvh bvh = hand_laid_pairs();
     bvh.nodes[2].first_child = 6;  // 6 + 2 > 7 nodes
     EXPECT_NE(structure_problem(bvh).find("past the end"), std::string::npos);
 }
 
 TEST(CheckStructure, RefusesAChildRangeWhoseEndOverflows32Bits) {
-    Bvh bvh = two_pairs();
+    Bvh bvh = hand_laid_pairs();
     bvh.nodes[2].first_child = 5;
     bvh.nodes[2].child_count = UINT32_MAX - 2;  // 5 + count wraps to 2 in 32 bits
     EXPECT_NE(structure_problem(bvh).find("past the end"), std::string::npos);
@@ -58,33 +58,33 @@ TEST(CheckStructure, RefusesAChildRangeWhoseEndOverflows32Bits) {
 TEST(CheckStructure, RefusesANonBreadthFirstOrder) {
     // Swapping the two groups' child ranges keeps every index in range and every node with one parent,
     // but node 1's children no longer come first: depth-first-like orders break the level layout.
-    Bvh bvh = two_pairs();
+    Bvh bvh = hand_laid_pairs();
     std::swap(bvh.nodes[1].first_child, bvh.nodes[2].first_child);
     std::swap(bvh.nodes[1].volume, bvh.nodes[2].volume);
     EXPECT_NE(structure_problem(bvh).find("breadth-first"), std::string::npos);
     // A child range pointing back at the root (a cycle).
-    Bvh cycle = two_pairs();
+    Bvh cycle = hand_laid_pairs();
     cycle.nodes[1].first_child = 0;
     EXPECT_NE(structure_problem(cycle), "");
 }
 
 TEST(CheckStructure, RefusesMissingDuplicateAndOutOfRangePrimitives) {
-    Bvh duplicate = two_pairs();
+    Bvh duplicate = hand_laid_pairs();
     duplicate.nodes[6].primitive = 0;
     EXPECT_NE(structure_problem(duplicate).find("two leaves"), std::string::npos);
-    Bvh missing = two_pairs();
+    Bvh missing = hand_laid_pairs();
     missing.nodes[6].primitive = 99;
     EXPECT_NE(structure_problem(missing).find("missing primitive"), std::string::npos);
-    Bvh extra = two_pairs();
-    extra.primitives.push_back(unit_box_at(20));
+    Bvh extra = hand_laid_pairs();
+    extra.primitives.push_back(structure_box_at(20));
     EXPECT_NE(structure_problem(extra).find("in no leaf"), std::string::npos);
 }
 
 TEST(CheckStructure, RefusesBadGeometryInANodeOrAPrimitive) {
-    Bvh nan_node = two_pairs();
+    Bvh nan_node = hand_laid_pairs();
     nan_node.nodes[1].volume = Sphere{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), 5.0};
     EXPECT_NE(structure_problem(nan_node).find("node 1"), std::string::npos);
-    Bvh negative = two_pairs();
+    Bvh negative = hand_laid_pairs();
     negative.primitives[2].volume = Sphere{Vec3(4, 0, 0), -1.0};
     EXPECT_NE(structure_problem(negative).find("primitive 2"), std::string::npos);
 }
@@ -215,7 +215,7 @@ TEST(Validate, ToleranceIsRelativeForSmallModels) {
     // A model of a millimetre: a volume 1e-6 short of its primitive (0.1 % of its size) is not "enclosing",
     // though an absolute 1e-9 floor of one unit would... not catch 1e-10 either; check both scales.
     for (const double scale : {1e-3, 1.0, 1e3}) {
-        Bvh bvh = two_pairs();
+        Bvh bvh = hand_laid_pairs();
         for (Primitive& p : bvh.primitives) {
             Aabb& box = std::get<Aabb>(p.volume);
             box = Aabb{box.min * scale, box.max * scale};
