@@ -12,6 +12,7 @@ packages=(
   libbullet-dev libfcl-dev graphviz
   chromium
   clang-16 libclang-rt-16-dev
+  pybind11-dev python3-dev python3-numpy python3-pytest
 )
 missing=()
 # Node may come from elsewhere than Debian (its npm then comes with it): ask Debian only when absent.
