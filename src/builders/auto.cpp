@@ -37,8 +37,8 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     std::string skipped;
     std::size_t done = 0;
     for (Algorithm member : members) {
-        // Under a time limit the members share it: each gets what is left, and once nothing is left the rest
-        // are skipped (the first always runs, so there is a tree). split and the insertions cannot stop early.
+        // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
+        // once nothing is left the rest are skipped (the first always runs, so there is a tree).
         if (best && limited && context.expired()) {
             skipped += (skipped.empty() ? "" : ", ") + std::string(to_string(member));
             continue;
