@@ -24,6 +24,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/bundled_models.hpp"
 #include "support/test_helpers.hpp"
 
 namespace hbvh {
@@ -218,28 +219,6 @@ std::vector<std::pair<std::string, std::vector<Primitive>>> generated_scenes() {
     return scenes;
 }
 
-/// The bundled models: shipped with the repository, so a missing folder or an unreadable file fails.
-std::vector<std::pair<std::string, std::vector<Primitive>>> bundled_models() {
-    std::vector<std::pair<std::string, std::vector<Primitive>>> models;
-    const std::filesystem::path folder = std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models";
-    if (!std::filesystem::is_directory(folder)) {
-        ADD_FAILURE() << "missing bundled models: " << folder;
-        return models;
-    }
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-        if (entry.path().extension() != ".xml") continue;
-        Result<XmlModel> model = read_xml_file(entry.path());
-        if (!model.has_value()) {
-            ADD_FAILURE() << entry.path() << ": " << model.error().to_string();
-            continue;
-        }
-        models.emplace_back(entry.path().stem().string(), std::move(model->primitives));
-    }
-    std::sort(models.begin(), models.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    EXPECT_FALSE(models.empty()) << "no *.xml in " << folder;
-    return models;
-}
-
 TEST(BnbExact, IsRegistered) { EXPECT_EQ(parse_algorithm("bnb-exact"), Algorithm::bnb_exact); }
 
 TEST(BnbExact, ExhaustiveEnumerationCountsEveryPartition) {
@@ -270,7 +249,7 @@ TEST(BnbExact, EachLevelOptimalAndNoCostlierThanEnlargesOnGeneratedScenes) {
 
 TEST(BnbExact, EachLevelOptimalAndNoCostlierThanEnlargesOnBundledModels) {
     int compared = 0;
-    for (const auto& [name, primitives] : bundled_models()) compared += expect_exact_levels(primitives, name);
+    for (const auto& [name, primitives] : test_support::bundled_models()) compared += expect_exact_levels(primitives, name);
     EXPECT_GE(compared, 5);
 }
 

@@ -18,6 +18,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/bundled_models.hpp"
 #include "support/test_helpers.hpp"
 
 namespace hbvh {
@@ -117,29 +118,10 @@ TEST(BranchAndBoundBuilders, ValidOnGeneratedScenesAndInvariantUnderShuffles) {
     }
 }
 
-/// The bundled survey models (data/models/*.xml). They ship with the repository: a missing folder or
-/// an empty one fails the calling test.
-std::vector<std::filesystem::path> model_files() {
-    std::vector<std::filesystem::path> files;
-    const std::filesystem::path folder = std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models";
-    if (!std::filesystem::is_directory(folder)) {
-        ADD_FAILURE() << "missing bundled models: " << folder;
-        return files;
-    }
-    for (const auto& entry : std::filesystem::directory_iterator(folder))
-        if (entry.path().extension() == ".xml") files.push_back(entry.path());
-    std::sort(files.begin(), files.end());
-    EXPECT_FALSE(files.empty()) << "no *.xml in " << folder;
-    return files;
-}
-
 TEST(BranchAndBoundBuilders, ValidOnBundledModels) {
-    for (const auto& file : model_files()) {
-        const Result<XmlModel> model = read_xml_file(file);
-        ASSERT_TRUE(model.has_value()) << model.error().to_string();
-        const auto& primitives = model->primitives;
+    for (const auto& [name, primitives] : test_support::bundled_models()) {
         for (Algorithm algorithm : bnb_algorithms) {
-            const std::string what = std::string(to_string(algorithm)) + " " + file.filename().string();
+            const std::string what = std::string(to_string(algorithm)) + " " + name;
             BuildReport report;
             const Result<Bvh> bvh = build_budgeted(primitives, algorithm, test_support::context_for(VolumePolicy::all(), &report));
             ASSERT_TRUE(bvh.has_value()) << what;
@@ -155,8 +137,7 @@ TEST(BranchAndBoundBuilders, ValidOnBundledModels) {
 
 /// Opt-in survey of costs, times and candidate counts (run with --gtest_also_run_disabled_tests).
 TEST(BranchAndBoundBuilders, DISABLED_PrintSurvey) {
-    std::vector<std::pair<std::string, std::vector<Primitive>>> inputs;
-    for (const auto& file : model_files()) inputs.emplace_back(file.filename().string(), read_xml_file(file)->primitives);
+    std::vector<std::pair<std::string, std::vector<Primitive>>> inputs = test_support::bundled_models();
     for (std::uint32_t count : {8u, 13u, 17u, 21u, 27u, 30u}) {
         SceneOptions scene;
         scene.count = count;

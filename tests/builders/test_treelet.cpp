@@ -15,6 +15,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/bundled_models.hpp"
 #include "support/test_helpers.hpp"
 #include "support/tree_properties.hpp"
 
@@ -22,29 +23,6 @@ namespace hbvh {
 namespace {
 
 using test_support::generated_scene;
-
-/// The bundled models, sorted by name. They ship with the repository, so a missing folder, an empty one
-/// or an unreadable file is a failure, not a reason to skip.
-std::vector<std::pair<std::string, std::vector<Primitive>>> bundled_models() {
-    std::vector<std::pair<std::string, std::vector<Primitive>>> models;
-    const std::filesystem::path folder = std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models";
-    if (!std::filesystem::is_directory(folder)) {
-        ADD_FAILURE() << "missing bundled models: " << folder;
-        return models;
-    }
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) {
-        if (entry.path().extension() != ".xml") continue;
-        Result<XmlModel> model = read_xml_file(entry.path());
-        if (!model.has_value()) {
-            ADD_FAILURE() << entry.path() << ": " << model.error().to_string();
-            continue;
-        }
-        models.emplace_back(entry.path().stem().string(), std::move(model->primitives));
-    }
-    std::sort(models.begin(), models.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    EXPECT_FALSE(models.empty()) << "no *.xml in " << folder;
-    return models;
-}
 
 Bvh build_with(const std::vector<Primitive>& primitives, Algorithm algorithm) {
     Result<Bvh> built = build(primitives, algorithm, {});
@@ -66,7 +44,7 @@ void expect_refined_well(const Bvh& input, const Bvh& refined, const TreeletRepo
 }
 
 TEST(Treelet, NeverCostlierOnBundledModels) {
-    for (const auto& [name, primitives] : bundled_models()) {
+    for (const auto& [name, primitives] : test_support::bundled_models()) {
         for (Algorithm algorithm : {Algorithm::two_level, Algorithm::split, Algorithm::insertion, Algorithm::merge}) {
             const Bvh input = build_with(primitives, algorithm);
             TreeletReport report;
@@ -200,7 +178,7 @@ TEST(Auto, EqualsTheOptimumUpToTenPrimitivesAndNeverBeatsItAbove) {
 TEST(Auto, NeverBeatsTheOptimumOnSmallBundledModels) {
     const BuildContext options = exact_fit_options();
     int checked = 0;
-    for (const auto& [name, primitives] : bundled_models()) {
+    for (const auto& [name, primitives] : test_support::bundled_models()) {
         if (primitives.size() > 14) continue;  // optimal's fits double per primitive
         const double optimum = cost_of(primitives, Algorithm::optimal, options);
         EXPECT_GE(cost_of(primitives, Algorithm::automatic, options), optimum * (1.0 - 1e-12)) << name;
