@@ -1,22 +1,16 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/builders/auto.hpp"
 
-#include <cstdio>
 #include <optional>
 #include <string>
 
 #include "guarded_build.hpp"
+#include "report_text.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
 namespace {
-
-std::string format_cost(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", value);
-    return text;
-}
 
 /// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
 /// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
@@ -52,12 +46,12 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         Bvh tree = std::move(built.value());
         double member_cost = cost(tree, context.policy);
         if (!costs.empty()) costs += ", ";
-        costs += std::string(to_string(member)) + " " + format_cost(member_cost);
+        costs += std::string(to_string(member)) + " " + detail::format_cost(member_cost);
         TreeletReport treelets;
         if (refine_each) {
             tree = refine_treelets(tree, context.policy, treelets_within(context, options.treelets), &treelets);
             member_cost = treelets.cost_after;
-            costs += " -> " + format_cost(member_cost);
+            costs += " -> " + detail::format_cost(member_cost);
         }
         if (!best || member_cost < best_cost) {
             best = std::move(tree);

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "hbvh/assert.hpp"
+#include "report_text.hpp"
 
 namespace hbvh {
 namespace {
@@ -109,19 +110,11 @@ Result<Bvh> build_refined(std::span<const Primitive> primitives, Algorithm algor
     return refined;
 }
 
-namespace {
-std::string detail_format_cost(double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", value);
-    return text;
-}
-}  // namespace
-
 void note_treelets(BuildReport& report, const TreeletReport& treelets) {
     report.notes.push_back("treelets: " + std::to_string(treelets.passes) + " passes, " +
                            std::to_string(treelets.replaced) + " of " + std::to_string(treelets.treelets) +
                            " treelets replaced, " + std::to_string(treelets.fits) + " fits, cost " +
-                           detail_format_cost(treelets.cost_before) + " -> " + detail_format_cost(treelets.cost_after) +
+                           detail::format_cost(treelets.cost_before) + " -> " + detail::format_cost(treelets.cost_after) +
                            (treelets.time_limit_hit ? " (time limit hit)" : ""));
     if (treelets.time_limit_hit) report.budget_hit = true;
 }
