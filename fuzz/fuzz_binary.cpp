@@ -8,6 +8,7 @@
 #include <string_view>
 #include <vector>
 
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/binary_format.hpp"
 #include "hbvh/tree/validate.hpp"
 
@@ -21,14 +22,19 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         std::uint64_t crc = hbvh::crc64_xz(bytes.first(size - 8));
         for (std::size_t i = 0; i < 8; ++i) resealed[size - 8 + i] = static_cast<std::byte>(crc >> (8 * i));
         bvh = hbvh::read_binary(resealed, "fuzz-resealed");
+        if (bvh && (bvh->nodes.empty() ? !hbvh::validate_primitives(bvh->primitives) : !hbvh::check_structure(bvh.value())))
+            std::abort();
         if (bvh && hbvh::write_binary(bvh.value()) !=
                        std::string_view(reinterpret_cast<const char*>(resealed.data()), resealed.size()))
             std::abort();
         return 0;
     }
     if (!bvh) return 0;
-    // Accepted means a tree the queries can use, and the encoding is canonical: writing it gives the input back.
+    // Accepted means a tree the queries can use (or usable primitives: the reader decides on the fly and runs
+    // these full checks only when something looks wrong, so they must agree), and the encoding is canonical:
+    // writing it gives the input back.
     if (!bvh->nodes.empty() && !hbvh::check_structure(bvh.value())) std::abort();
+    if (bvh->nodes.empty() && !hbvh::validate_primitives(bvh->primitives)) std::abort();
     if (hbvh::write_binary(bvh.value()) != std::string_view(reinterpret_cast<const char*>(data), size)) std::abort();
     return 0;
 }

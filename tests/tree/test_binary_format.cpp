@@ -9,10 +9,16 @@
 #include <filesystem>
 #include <iterator>
 #include <limits>
+#include <thread>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "hbvh/builders/build.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/binary_format.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
@@ -109,6 +115,33 @@ TEST(BinaryFormat, Crc64MatchesTheStandardCheckValue) {
     // The 8-byte loop and the byte tail agree: every split of the same bytes gives one CRC (a longer input).
     const std::string longer = "The quick brown fox jumps over the lazy dog";
     EXPECT_EQ(crc64_xz(as_span(longer)), 0x5B5EB8C2E54AA1C4ULL);
+}
+
+/// CRC-64/XZ one bit at a time, straight from its definition: the reference for the fast paths.
+std::uint64_t crc64_bitwise(const unsigned char* p, std::size_t n) {
+    std::uint64_t crc = ~std::uint64_t{0};
+    for (std::size_t i = 0; i < n; ++i) {
+        crc ^= p[i];
+        for (int bit = 0; bit < 8; ++bit) crc = (crc & 1) != 0 ? (crc >> 1) ^ 0xC96C5795D7870F42ULL : crc >> 1;
+    }
+    return ~crc;
+}
+
+TEST(BinaryFormat, Crc64FastPathsMatchTheBitwiseDefinition) {
+    // Every length across the switch from tables to carry-less folding (256 bytes), the 64- and 16-byte
+    // steps and the tail, at several alignments, and one long buffer.
+    std::string bytes(1 << 16, '\0');
+    std::uint64_t state = 0x9E3779B97F4A7C15ULL;
+    for (char& c : bytes) {
+        state = state * 6364136223846793005ULL + 1442695040888963407ULL;
+        c = static_cast<char>(state >> 56);
+    }
+    const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+    for (std::size_t offset : {0u, 1u, 7u, 13u})
+        for (std::size_t n = 0; n <= 1200; ++n)
+            ASSERT_EQ(crc64_xz(as_span(bytes).subspan(offset, n)), crc64_bitwise(data + offset, n))
+                << "length " << n << " at offset " << offset;
+    EXPECT_EQ(crc64_xz(as_span(bytes)), crc64_bitwise(data, bytes.size()));
 }
 
 TEST(BinaryFormat, LayoutIsLittleEndianFieldByField) {
@@ -260,6 +293,117 @@ TEST(BinaryFormat, MalformedTreesAndBadGeometryBehindAGoodChecksumAreRefused) {
     back = read(unknown_kind);
     ASSERT_FALSE(back.has_value());
     EXPECT_EQ(back.error().message.rfind("offset 40: unknown volume kind 9", 0), 0u) << back.error().message;
+}
+
+/// A rotation about z by `angle`, then its first entry scaled by 1 + `skew` (no longer exactly orthonormal).
+Mat3 skewed_rotation(double angle, double skew) {
+    Mat3 r;
+    r << std::cos(angle), -std::sin(angle), 0, std::sin(angle), std::cos(angle), 0, 0, 0, 1;
+    r(0, 0) *= 1.0 + skew;
+    return r;
+}
+
+TEST(BinaryFormat, OnTheFlyChecksAgreeWithTheFullChecks) {
+    // The reader tests each record as it decodes it and runs check_structure / validate_primitives only when
+    // something looks wrong; whatever the case, it must accept exactly what those accept, with their words.
+    const double tiny = std::numeric_limits<double>::denorm_min(), huge = std::numeric_limits<double>::max();
+    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    std::vector<std::pair<std::string, Bvh>> cases;
+    auto add = [&](std::string what, auto edit) {
+        Bvh tree = small_tree();
+        edit(tree);
+        cases.emplace_back(what, tree);
+        Bvh set = tree;  // the same primitives as a primitive set, where the edit touched them
+        set.nodes.clear();
+        cases.emplace_back(what + " (primitive set)", set);
+    };
+    auto root = [](Bvh& b) -> Obb& { return std::get<Obb>(b.nodes[0].volume); };
+    auto leaf_sphere = [](Bvh& b) -> Sphere& { return std::get<Sphere>(b.primitives[1].volume); };
+    add("unchanged", [](Bvh&) {});
+    // Rotations at both sides of rotation_tolerance (|R^T R - I| is about 2 x skew here).
+    for (const double skew : {1e-12, 1e-10, 2e-10, 3e-10, 4e-10, 6e-10, 1e-9})
+        add("rotation skewed by " + std::to_string(skew), [&](Bvh& b) { root(b).rotation = skewed_rotation(0.3, skew); });
+    add("reflection", [&](Bvh& b) { root(b).rotation(2, 2) = -1.0; });
+    add("NaN rotation", [&](Bvh& b) { root(b).rotation(1, 2) = nan; });
+    add("infinite centre", [&](Bvh& b) { root(b).center.y() = inf; });
+    add("half extent 0", [&](Bvh& b) { root(b).half_extents.x() = 0.0; });
+    add("subnormal half extent", [&](Bvh& b) { root(b).half_extents.z() = tiny; });
+    add("negative half extent", [&](Bvh& b) { root(b).half_extents.y() = -1.0; });
+    add("half extent overflowing when doubled", [&](Bvh& b) { root(b).half_extents.x() = huge; });
+    add("box corners with NaN", [&](Bvh& b) { std::get<Aabb>(b.nodes[1].volume).min.z() = nan; });
+    add("box turned inside out", [](Bvh& b) { std::get<Aabb>(b.nodes[1].volume).max.x() = -2.0; });
+    add("flat box", [](Bvh& b) { std::get<Aabb>(b.nodes[1].volume).max.x() = -1.0; });
+    add("box extent overflowing", [&](Bvh& b) {
+        std::get<Aabb>(b.nodes[1].volume).min.x() = -huge;
+        std::get<Aabb>(b.nodes[1].volume).max.x() = huge;
+    });
+    add("box extent subnormal", [&](Bvh& b) { std::get<Aabb>(b.nodes[1].volume).max.x() = -1.0 + 0x1p-60; });
+    add("radius 0", [&](Bvh& b) { leaf_sphere(b).radius = 0.0; });
+    add("radius subnormal", [&](Bvh& b) { leaf_sphere(b).radius = tiny; });
+    add("radius -0", [&](Bvh& b) { leaf_sphere(b).radius = -0.0; });
+    add("radius NaN", [&](Bvh& b) { leaf_sphere(b).radius = nan; });
+    add("sphere centre infinite", [&](Bvh& b) { leaf_sphere(b).center.x() = -inf; });
+    add("capsule length overflowing", [&](Bvh& b) {
+        std::get<Capsule>(b.nodes[2].volume).p0.x() = -huge;
+        std::get<Capsule>(b.nodes[2].volume).p1.x() = huge;
+    });
+    add("capsule centre overflowing", [&](Bvh& b) {
+        std::get<Capsule>(b.nodes[2].volume).p0.x() = huge;
+        std::get<Capsule>(b.nodes[2].volume).p1.x() = huge;
+    });
+    add("capsule radius negative", [](Bvh& b) { std::get<Capsule>(b.nodes[2].volume).radius = -1.0; });
+    add("leaf of a missing primitive", [](Bvh& b) { b.nodes[5].primitive = 4; });
+    add("two leaves of one primitive", [](Bvh& b) { b.nodes[6].primitive = 1; });
+    add("single child", [](Bvh& b) { b.nodes[1].child_count = 1; });
+    add("children out of order", [](Bvh& b) { std::swap(b.nodes[1].first_child, b.nodes[2].first_child); });
+    add("child range past the end", [](Bvh& b) { b.nodes[2].child_count = 3; });
+    add("a node nobody's child", [](Bvh& b) {
+        b.nodes[0].child_count = 2;
+        b.nodes[2].child_count = 0;  // now a leaf, with node 2's primitive (0), which node 3 has too
+    });
+    add("a primitive in no leaf", [](Bvh& b) { b.primitives.push_back(b.primitives[0]); });
+    std::size_t refused = 0;
+    for (const auto& [what, bvh] : cases) {
+        const Status expected = bvh.nodes.empty() ? validate_primitives(bvh.primitives) : check_structure(bvh);
+        const Result<Bvh> back = read(write_binary(bvh));
+        ASSERT_EQ(back.has_value(), expected.has_value()) << what << ": " << (back ? "" : back.error().message);
+        if (back) {
+            expect_same(bvh, back.value());
+            continue;
+        }
+        ++refused;
+        const std::string& message = back.error().message;
+        EXPECT_EQ(message.substr(message.find(": ") + 2), expected.error().message) << what;
+    }
+    EXPECT_GE(refused, 25u);  // most edits make a refusal (those of nodes not in the primitive-set copies)
+}
+
+TEST(BinaryFormat, FileHelpersReadFromAPipe) {
+    // No size to go by: the reader grows its buffer as the bytes come (here beyond eight times its first 64 KiB).
+    const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "hbvh_binary_format_pipe";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path fifo = dir / "tree.hbvh";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    const Bvh original = built(named_scene(6'000, 9), Algorithm::two_level);
+    const std::string bytes = write_binary(original);
+    ASSERT_GT(bytes.size(), 8u * 65536u);
+    std::thread writer([&] {
+        const int fd = ::open(fifo.c_str(), O_WRONLY | O_CLOEXEC);
+        if (fd < 0) return;
+        for (std::string_view rest = bytes; !rest.empty();) {
+            // Odd-sized writes, so the reads end anywhere.
+            const ssize_t written = ::write(fd, rest.data(), std::min<std::size_t>(rest.size(), 70'001));
+            if (written <= 0) break;
+            rest.remove_prefix(static_cast<std::size_t>(written));
+        }
+        ::close(fd);
+    });
+    Result<Bvh> back = read_binary_file(fifo);
+    writer.join();
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    expect_same(original, back.value());
+    std::filesystem::remove_all(dir);
 }
 
 TEST(BinaryFormat, OtherVersionsMagicAndTrailingBytesAreRefused) {

@@ -23,7 +23,8 @@ inline constexpr std::uint32_t binary_format_version = 1;
 
 /// CRC-64/XZ (ECMA-182 polynomial 0x42F0E1EBA9EA3693, reflected, initial value and final xor all ones) of
 /// `bytes`: the checksum in the last 8 bytes of a .hbvh file. Its check value, of "123456789", is
-/// 0x995DC9BBDF1939FA.
+/// 0x995DC9BBDF1939FA. Computed by carry-less multiplication where the CPU has it (x86-64 with PCLMULQDQ, checked
+/// at run time), else by slicing-by-8 tables; both give the same value.
 [[nodiscard]] std::uint64_t crc64_xz(std::span<const std::byte> bytes);
 
 /// `bvh` as a .hbvh file (docs/formats.md has the layout): every field written little-endian one by one,
@@ -39,11 +40,13 @@ inline constexpr std::uint32_t binary_format_version = 1;
 /// non-zero reserved bits, a truncated file or bytes after its end, a checksum mismatch, counts the file
 /// cannot hold, an unknown volume kind, a name that is not UTF-8 (or holds a NUL), no primitives, and then,
 /// through check_structure() (nodes) or validate_primitives() (a primitive set), a malformed tree or
-/// unusable geometry (NaN, negative sizes, a matrix that is no rotation). A primitive set comes back as a
-/// Bvh with no nodes. Containment is not checked: run validate() for that, as for XML.
+/// unusable geometry (NaN, negative sizes, a matrix that is no rotation). Those checks are made on the fly
+/// while decoding; the full functions run (for their messages) only when something fails. A primitive set
+/// comes back as a Bvh with no nodes. Containment is not checked: run validate() for that, as for XML.
 [[nodiscard]] Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view source_name);
 
-/// Reads the file at `path` and parses it with read_binary; errors name the file as given.
+/// Reads the file at `path` (one buffer sized from the file, in huge pages where Linux offers them; pipes and
+/// growing files are read to their end) and parses it with read_binary; errors name the file as given.
 [[nodiscard]] Result<Bvh> read_binary_file(const std::filesystem::path& path);
 
 /// Writes write_binary(bvh) to `path` atomically: a new temporary file in the same directory, fsync, then
