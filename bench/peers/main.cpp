@@ -103,6 +103,7 @@ struct Row {
     Regime regime = Regime::partial;
     std::size_t poses = 0;
     double hbvh_us = 0, two_level_us = 0, bullet_us = 0, fcl_us = 0, fcl_collide_us = 0;
+    double hbvh_first_us = 0, two_level_first_us = 0;  ///< CollideMode::first (hbvh only: the peers' "any contact" modes differ).
     std::uint64_t hbvh_pairs = 0;
     Agreement bullet, fcl;
 };
@@ -119,6 +120,8 @@ struct Options {
     std::size_t poses = 32;
     int repetitions = 7;
     double tolerance = 1e-6;  ///< Relative to the object's size: pairs closer than this to touching are not judged.
+    std::string only;         ///< When set, only objects whose name contains it.
+    bool fastest = false;     ///< Query rows give the fastest repetition instead of the median.
 };
 
 Algorithm pick_algorithm() {
@@ -260,17 +263,26 @@ void run_object(const Object& object, const Options& options, std::vector<Row>& 
             fcl->collide(peer_pairs);
             compare(result.pairs, peer_pairs, object.primitives, pose, tolerance, row.fcl);
         }
-        std::vector<double> hbvh_t, two_level_t, bullet_t, fcl_t, fcl_collide_t;
+        std::vector<double> hbvh_t, two_level_t, bullet_t, fcl_t, fcl_collide_t, hbvh_first_t, two_level_first_t;
         for (int r = 0; r < repetitions; ++r) {
+            const auto time_hbvh = [&](auto query, CollideMode mode, std::vector<double>& samples) {
+                const auto start = Clock::now();
+                for (const RigidTransform& pose : poses) query(*tree, RigidTransform::identity(), *tree, pose, mode, result);
+                samples.push_back(seconds_since(start) / count);
+            };
+            const auto tandem = [](const QueryTree& a, const RigidTransform& pa, const QueryTree& b,
+                                   const RigidTransform& pb, CollideMode mode, CollideResult& out) {
+                collide(a, pa, b, pb, mode, out);
+            };
+            const auto two_level = [](const QueryTree& a, const RigidTransform& pa, const QueryTree& b,
+                                      const RigidTransform& pb, CollideMode mode, CollideResult& out) {
+                collide_two_level(a, pa, b, pb, mode, out);
+            };
+            time_hbvh(tandem, CollideMode::all, hbvh_t);
+            time_hbvh(two_level, CollideMode::all, two_level_t);
+            time_hbvh(tandem, CollideMode::first, hbvh_first_t);
+            time_hbvh(two_level, CollideMode::first, two_level_first_t);
             auto start = Clock::now();
-            for (const RigidTransform& pose : poses)
-                collide(*tree, RigidTransform::identity(), *tree, pose, CollideMode::all, result);
-            hbvh_t.push_back(seconds_since(start) / count);
-            start = Clock::now();
-            for (const RigidTransform& pose : poses)
-                collide_two_level(*tree, RigidTransform::identity(), *tree, pose, CollideMode::all, result);
-            two_level_t.push_back(seconds_since(start) / count);
-            start = Clock::now();
             for (const RigidTransform& pose : poses) {
                 bullet->set_pose(pose);
                 bullet->collide(peer_pairs);
@@ -289,11 +301,16 @@ void run_object(const Object& object, const Options& options, std::vector<Row>& 
             fcl_t.push_back(total / count);
             fcl_collide_t.push_back(collide_only / count);
         }
-        row.hbvh_us = 1e6 * median(hbvh_t);
-        row.two_level_us = 1e6 * median(two_level_t);
-        row.bullet_us = 1e6 * median(bullet_t);
-        row.fcl_us = 1e6 * median(fcl_t);
-        row.fcl_collide_us = 1e6 * median(fcl_collide_t);
+        const auto statistic = [&](std::vector<double>& samples) {
+            return 1e6 * (options.fastest ? *std::min_element(samples.begin(), samples.end()) : median(samples));
+        };
+        row.hbvh_us = statistic(hbvh_t);
+        row.two_level_us = statistic(two_level_t);
+        row.hbvh_first_us = statistic(hbvh_first_t);
+        row.two_level_first_us = statistic(two_level_first_t);
+        row.bullet_us = statistic(bullet_t);
+        row.fcl_us = statistic(fcl_t);
+        row.fcl_collide_us = statistic(fcl_collide_t);
         rows.push_back(row);
     }
 }
@@ -310,15 +327,21 @@ void print(const std::vector<BuildRow>& builds, const std::vector<Row>& rows, co
         for (const BuildRow& b : builds)
             fmt::print("| {} | {} | {:.3f} | {:.3f} | {:.3f} | {:.4g} | {:.4g} | {:.4g} |\n", b.object, b.primitives,
                        b.hbvh_ms, b.bullet_ms, b.fcl_ms, b.hbvh_cost, b.bullet_cost, b.fcl_cost);
-        fmt::print("\n### Query (µs per pose, median of {} repetitions)\n\n", options.repetitions);
-        fmt::print("| object | prims | regime | poses | hbvh | hbvh 2-level | bullet | fcl | fcl collide only | "
-                   "bullet/hbvh | fcl/hbvh | hbvh pairs | bullet =/+/-/~ | fcl =/+/-/~ |\n");
-        fmt::print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
+        fmt::print("\n### Query (µs per pose, {} of {} repetitions)\n\n", options.fastest ? "fastest" : "median",
+                   options.repetitions);
+        fmt::print("| object | prims | regime | poses | hbvh | hbvh 2-level | tandem/2-level | hbvh first | 2-level first | "
+                   "tandem/2-level first | bullet | fcl | fcl collide only | bullet/hbvh | fcl/hbvh | faster peer/hbvh | "
+                   "hbvh pairs | bullet =/+/-/~ | fcl =/+/-/~ |\n");
+        fmt::print("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---|---|\n");
         for (const Row& r : rows)
-            fmt::print("| {} | {} | {} | {} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {:.2f} | {} | {} | {} | {} | {} |\n",
+            fmt::print("| {} | {} | {} | {} | {:.2f} | {:.2f} | {} | {:.2f} | {:.2f} | {} | {:.2f} | {:.2f} | {:.2f} | {} | {} "
+                       "| {} | {} | {} | {} |\n",
                        r.object, r.primitives, regime_name(r.regime), r.poses, r.hbvh_us, r.two_level_us,
-                       r.bullet_us, r.fcl_us, r.fcl_collide_us, ratio(r.bullet_us, r.hbvh_us),
-                       ratio(r.fcl_us, r.hbvh_us), r.hbvh_pairs, agreement_text(r.bullet), agreement_text(r.fcl));
+                       ratio(r.hbvh_us, r.two_level_us), r.hbvh_first_us, r.two_level_first_us,
+                       ratio(r.hbvh_first_us, r.two_level_first_us), r.bullet_us, r.fcl_us, r.fcl_collide_us,
+                       ratio(r.bullet_us, r.hbvh_us), ratio(r.fcl_us, r.hbvh_us),
+                       ratio(std::min(r.bullet_us, r.fcl_collide_us), r.hbvh_us), r.hbvh_pairs,
+                       agreement_text(r.bullet), agreement_text(r.fcl));
         return;
     }
     fmt::print("{:<18} {:>6} {:>10} {:>10} {:>10} {:>11} {:>11} {:>11}\n", "object", "prims", "hbvh_ms", "bullet_ms",
@@ -350,8 +373,12 @@ int main(int argc, char** argv) {
             options.poses = std::strtoul(argv[++i], nullptr, 10);
         } else if (arg == "--repetitions" && i + 1 < argc) {
             options.repetitions = std::atoi(argv[++i]);
+        } else if (arg == "--fastest") {
+            options.fastest = true;
+        } else if (arg == "--only" && i + 1 < argc) {
+            options.only = argv[++i];
         } else {
-            fmt::print(stderr, "usage: hbvh_peers [--markdown] [--poses N] [--repetitions N]\n");
+            fmt::print(stderr, "usage: hbvh_peers [--markdown] [--poses N] [--repetitions N] [--only NAME] [--fastest]\n");
             return 2;
         }
     }
@@ -359,7 +386,8 @@ int main(int argc, char** argv) {
     std::vector<BuildRow> builds;
     fmt::print(stderr, "hbvh_peers: builder {}; real models (MJCF/URDF) skipped: no importer in include/hbvh/io/\n",
                hbvh::to_string(pick_algorithm()));
-    for (const Object& object : load_objects()) run_object(object, options, rows, builds);
+    for (const Object& object : load_objects())
+        if (object.name.find(options.only) != std::string::npos) run_object(object, options, rows, builds);
     print(builds, rows, options);
     // A disagreement beyond the tolerance means one of the three is wrong: fail, so that scripts notice.
     std::uint64_t disagreements = 0;

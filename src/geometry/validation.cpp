@@ -90,7 +90,16 @@ Status validate_primitives(std::span<const Primitive> primitives) {
     return Ok{};
 }
 
+bool is_rigid_motion(const RigidTransform& pose) {
+    // The same three conditions as rotation_problem(), in the same arithmetic, so that the two never disagree.
+    const Mat3& r = pose.rotation;
+    return pose.translation.allFinite() && r.allFinite() &&
+           (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff() <= rotation_tolerance &&
+           std::abs(r.determinant() - 1.0) <= rotation_tolerance;
+}
+
 Status validate_pose(const RigidTransform& pose) {
+    if (is_rigid_motion(pose)) return Ok{};
     if (!pose.translation.allFinite()) return Error{"pose: translation is not finite"};
     if (std::string problem = rotation_problem(pose.rotation); !problem.empty()) return Error{"pose: " + problem};
     return Ok{};

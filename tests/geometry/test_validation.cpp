@@ -9,6 +9,7 @@
 #include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
+#include "hbvh/scene/generate.hpp"
 
 namespace hbvh {
 namespace {
@@ -88,6 +89,19 @@ TEST(ValidatePose, RefusesNonRigidMotions) {
     EXPECT_FALSE(validate_pose(nan_translation));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(0, 0, 0, 0)));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(nan, 0, 0, 1)));
+}
+
+TEST(ValidatePose, TheQuickCheckAgreesWithTheWordedOne) {
+    // is_rigid_motion() runs on every query, validate_pose() only to word a refusal: they must never
+    // disagree, also next to the tolerance, where rounding decides.
+    SplitMix64 rng(17);
+    for (int k = 0; k < 20000; ++k) {
+        RigidTransform pose{rng.rotation(), Vec3(rng.uniform(-1e3, 1e3), 0.0, 0.0)};
+        const double size = std::pow(10.0, rng.uniform(-12.0, -6.0));
+        pose.rotation(static_cast<int>(rng.below(3)), static_cast<int>(rng.below(3))) += rng.uniform(-size, size);
+        if (k % 7 == 0) pose.rotation.col(0) = -pose.rotation.col(0);
+        EXPECT_EQ(is_rigid_motion(pose), rotation_problem(pose.rotation).empty()) << k;
+    }
 }
 
 TEST(FromQuaternion, NormalisesAndMatchesAnAxisAngleRotation) {

@@ -95,8 +95,8 @@ TEST(Simulate, TandemAndTwoLevelSeeTheSameCollisions) {
 
 TEST(Simulate, TotallyCollidingCountersMatchBruteForce) {
     // Two copies at one pose: the baseline tests every one of the n^2 primitive pairs; the hierarchy must
-    // test at least every overlapping pair (it reports them all in `all` mode) and, if it prunes at all,
-    // fewer than n^2. The number of overlapping pairs is counted here at a few poses: it does not depend
+    // test at least every overlapping pair (it reports them all in `all` mode) and never more than n^2 (its
+    // flat pairs test small subtrees leaf by leaf, which in this regime may reach every pair). The number of overlapping pairs is counted here at a few poses: it does not depend
     // on the pose beyond rounding, so it is the same for every query.
     for (const Algorithm algorithm : multi_level_builders) {
         const std::string what(to_string(algorithm));
@@ -111,7 +111,7 @@ TEST(Simulate, TotallyCollidingCountersMatchBruteForce) {
         options.method = QueryMethod::tandem;
         const SimulationResult tandem = simulate(object, options);
         EXPECT_GE(tandem.total.mean_primitive_tests, static_cast<double>(overlapping)) << what;
-        EXPECT_LT(tandem.total.mean_primitive_tests, n * n) << what;
+        EXPECT_LE(tandem.total.mean_primitive_tests, n * n) << what;
     }
 }
 

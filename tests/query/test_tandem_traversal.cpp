@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <functional>
+#include <limits>
 #include <string>
 
 #include "hbvh/assert.hpp"
@@ -160,6 +162,12 @@ Work check_builder(const std::string& name, const std::function<Bvh(std::span<co
                 const Pairs expected = brute_force(a, pose_a, b, pose_b);
                 const std::string where = name + " case " + std::to_string(c.seed) + " pose " + std::to_string(k);
 
+                // Pure descent (no pair tested flat) and pure flat (the roots' leaves tested pairwise) must agree
+                // with the default's mix.
+                for (const std::uint64_t flat_limit : {std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max()}) {
+                    collide(qa, pose_a, qb, pose_b, CollideMode::all, reused, flat_limit);
+                    EXPECT_EQ(reused.pairs, expected) << where << " flat limit " << flat_limit;
+                }
                 collide(qa, pose_a, qb, pose_b, CollideMode::all, reused);
                 EXPECT_EQ(reused.pairs, expected) << where;
                 EXPECT_EQ(reused.intersecting, !expected.empty()) << where;
@@ -309,6 +317,54 @@ TEST(QueryTree, EnclosingSpheresContainEveryNode) {
             for (const Sphere& s : generating_spheres(bvh.nodes[i].volume))
                 EXPECT_LE((s.center - node.center).norm() + s.radius, node.sphere_radius) << "node " << i;
         }
+    }
+}
+
+TEST(QueryTree, EnclosingBoxesContainEveryNode) {
+    // The box test may only reject pairs whose BVs are apart: each node's box (centre, axes, half extents)
+    // must contain its BV, checked on the BV's generating spheres in the box's frame, for every kind.
+    for (const std::uint64_t seed : {1u, 2u, 3u}) {
+        const auto prims = generate_scene({.count = 27, .seed = seed});
+        const Bvh bvh = build_deep_mixed(prims, seed);
+        const QueryTree tree(bvh);
+        std::array<int, 4> kinds{};
+        for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+            const QueryNode& node = tree.nodes()[i];
+            ++kinds[static_cast<std::size_t>(node.type)];
+            EXPECT_LT((node.rotation.transpose() * node.rotation - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-12);
+            EXPECT_EQ(node.axis_aligned, node.rotation == Mat3::Identity()) << "node " << i;
+            for (const Sphere& s : generating_spheres(bvh.nodes[i].volume)) {
+                const Vec3 local = node.rotation.transpose() * (s.center - node.center);
+                EXPECT_TRUE((local.cwiseAbs().array() + s.radius <= node.half_extents.array()).all())
+                    << "node " << i << " sphere at " << s.center.transpose();
+            }
+        }
+        for (const int count : kinds) EXPECT_GT(count, 0);  // every kind of BV was checked
+    }
+}
+
+TEST(QueryTree, LeafRangesAreEachSubtreesLeaves) {
+    // Each node's [leaf_begin, leaf_begin + leaf_count) of leaves() must be exactly the leaves below it,
+    // found here by walking the Bvh's child ranges.
+    const auto prims = generate_scene({.count = 27, .seed = 5});
+    const Bvh bvh = build_deep_mixed(prims, 5);
+    const QueryTree tree(bvh);
+    ASSERT_EQ(tree.leaves().size(), prims.size());
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        std::vector<std::uint32_t> below, pending{i};
+        while (!pending.empty()) {
+            const std::uint32_t n = pending.back();
+            pending.pop_back();
+            if (bvh.nodes[n].is_leaf()) below.push_back(n);
+            for (std::uint32_t c = 0; c < bvh.nodes[n].child_count; ++c) pending.push_back(bvh.nodes[n].first_child + c);
+        }
+        const QueryNode& node = tree.nodes()[i];
+        ASSERT_LE(std::size_t{node.leaf_begin} + node.leaf_count, tree.leaves().size());
+        std::vector<std::uint32_t> range(tree.leaves().begin() + node.leaf_begin,
+                                         tree.leaves().begin() + node.leaf_begin + node.leaf_count);
+        std::sort(below.begin(), below.end());
+        std::sort(range.begin(), range.end());
+        EXPECT_EQ(range, below) << "node " << i;
     }
 }
 

@@ -27,6 +27,8 @@ inline constexpr double rotation_tolerance = 1e-9;
 [[nodiscard]] std::string volume_problem(const BoundingVolume& volume);
 /// Ok, or an Error naming the first bad primitive: "primitive 3 ('leg'): radius -0.5 is negative".
 [[nodiscard]] Status validate_primitives(std::span<const Primitive> primitives);
+/// validate_pose(pose) is Ok, without building a message: cheap enough to run on every query.
+[[nodiscard]] bool is_rigid_motion(const RigidTransform& pose);
 /// Ok, or an Error saying why `pose` is no rigid motion (non-finite numbers, no proper rotation).
 [[nodiscard]] Status validate_pose(const RigidTransform& pose);
 

@@ -46,24 +46,30 @@ private:
     Error error_;
 };
 
-/// One node of a QueryTree: the hot data of the traversal, 152 bytes. Same indices as the Bvh it came
+/// One node of a QueryTree: the hot data of the traversal, 160 bytes. Same indices as the Bvh it came
 /// from; everything in the Bvh's model frame. The exact BV lives in QueryTree::volume(i) (cold).
+/// Every node carries two conservative stand-ins for its BV, so that inner tests never read the variant:
+/// an enclosing sphere and an enclosing box (the BV itself for an Aabb or Obb; for a capsule the box along
+/// its segment, for a sphere the cube around it).
 struct QueryNode {
-    Vec3 center;                    ///< Box / sphere centre, capsule midpoint; also the enclosing sphere's centre.
+    Vec3 center;                    ///< Box / sphere centre, capsule midpoint: the centre of both stand-ins.
     double sphere_radius = 0.0;     ///< Radius of a sphere around the BV, padded by 1e-12 x (radius + |center|_1).
-    Mat3 rotation;                  ///< Box axes as columns (identity for an Aabb); identity otherwise.
-    Vec3 half_extents;              ///< Box half extents; zero otherwise.
+    Mat3 rotation;                  ///< The enclosing box's axes as columns (identity for an Aabb and a sphere).
+    Vec3 half_extents;              ///< The enclosing box's half extents.
     double measure = 0.0;           ///< volume(volume): the descent rule compares these.
     std::uint32_t first_child = 0;  ///< Children: [first_child, first_child + child_count).
     std::uint32_t child_count = 0;  ///< 0 for a leaf.
     std::uint32_t primitive = 0;    ///< For a leaf: the primitive's index in input order.
+    std::uint32_t leaf_begin = 0;   ///< The subtree's leaves: QueryTree::leaves()[leaf_begin, leaf_begin + leaf_count).
+    std::uint32_t leaf_count = 0;   ///< Leaves below (1 for a leaf).
     BvType type = BvType::aabb;     ///< The kind of the node's BV.
+    bool axis_aligned = true;       ///< rotation is the identity (an Aabb or a sphere): box tests skip a product.
 };
 
 /// The read-only layout queries run on, converted once from a Bvh (which stays the ground truth):
-/// flat node array, children contiguous, boxes as centre + axes + half extents with their enclosing
-/// spheres and volumes precomputed, the exact BVs in a separate array, and the stack depth a traversal
-/// can need.
+/// flat node array, children contiguous, every node with an enclosing sphere and an enclosing box and its
+/// volume precomputed, the exact BVs in a separate array, the leaves in depth-first order, and the stack
+/// depth a traversal can need.
 class QueryTree {
 public:
     /// Converts `bvh` after check_structure(bvh) (linear time): a malformed Bvh (child ranges past the end,
@@ -85,6 +91,13 @@ public:
     [[nodiscard]] std::span<const std::uint32_t> primitive_nodes() const { return primitive_nodes_; }
     /// Largest sum of child counts along a root-to-leaf path: this tree's share of the traversal stack.
     [[nodiscard]] std::uint32_t stack_bound() const { return stack_bound_; }
+    /// Leaf node indices in depth-first order, so that every subtree's leaves are one contiguous range
+    /// (QueryNode::leaf_begin, leaf_count): small node pairs are tested leaf by leaf from it.
+    [[nodiscard]] std::span<const std::uint32_t> leaves() const { return leaves_; }
+    /// Largest |center|_1 of any node: with extent_bound(), what rounding in a box test is relative to.
+    [[nodiscard]] double coordinate_bound() const { return coordinate_bound_; }
+    /// Largest sum of a node's enclosing-box half extents.
+    [[nodiscard]] double extent_bound() const { return extent_bound_; }
 
 private:
     struct Checked {};  // the Bvh passed check_structure()
@@ -94,24 +107,34 @@ private:
     std::vector<QueryNode> nodes_;
     std::vector<BoundingVolume> volumes_;
     std::vector<std::uint32_t> primitive_nodes_;
+    std::vector<std::uint32_t> leaves_;
     std::uint32_t stack_bound_ = 0;
+    double coordinate_bound_ = 0.0;
+    double extent_bound_ = 0.0;
 };
 
 /// The pose of b's model frame relative to a's: maps b-model coordinates to a-model coordinates.
 /// Queries run in a's model frame, so this is the one transform a query computes.
 [[nodiscard]] RigidTransform relative_transform(const RigidTransform& pose_a, const RigidTransform& pose_b);
 
+/// Node pairs whose leaf counts multiply to at most this are tested leaf by leaf, as the two-level query
+/// does: below it the inner tests a descent would spend cost more than the leaf tests they save
+/// (measured in docs/queries.md, "Flat pairs").
+inline constexpr std::uint64_t default_flat_pair_limit = 32;
+
 /// Tandem traversal (Erleben et al. 2005): from the root pair, expand the node with the larger volume
 /// (or the inner one, if the other is a leaf) and test its children against the other node; leaf pairs
-/// are exact primitive tests. Inner pairs are tested conservatively (enclosing spheres first; two boxes
-/// by the six face axes only), which never drops a pair but may expand a few more. pose_a / pose_b map
-/// each tree's model frame to the world. No allocation except growing `result.pairs` (and a heap stack
-/// when the two trees' stack bounds add up to more than the built-in 1024 entries).
-/// `result` is overwritten; reusing it across queries keeps the pairs' capacity.
+/// are exact primitive tests. Inner pairs are tested conservatively (enclosing spheres, then enclosing
+/// boxes by their six face axes), which never drops a pair but may expand a few more; a pair of subtrees
+/// with at most `flat_pair_limit` leaf pairs is tested leaf by leaf (0: always descend). pose_a / pose_b
+/// map each tree's model frame to the world. Each of b's leaves is moved into a's frame at most once per
+/// query, into a per-thread scratch that grows once to min(b's nodes, 4096) slots; nothing else allocates
+/// except growing `result.pairs` (and a heap stack when the two trees' stack bounds add up to more than
+/// the built-in 1024 entries). `result` is overwritten; reusing it across queries keeps the pairs' capacity.
 /// Each pose is checked once per query (validate_pose: finite, a proper rotation within 1e-9); a bad one
 /// sets result.error and nothing else.
 void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
-             CollideMode mode, CollideResult& result);
+             CollideMode mode, CollideResult& result, std::uint64_t flat_pair_limit = default_flat_pair_limit);
 /// As above, returning a fresh result.
 [[nodiscard]] CollideResult collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
                                     const RigidTransform& pose_b, CollideMode mode = CollideMode::all);
