@@ -178,8 +178,9 @@ inline bool leaves_overlap(const QueryTree& a, std::uint32_t ia, const QueryTree
 /// stack when it fits (no per-query cost), the heap otherwise.
 class PairStack {
 public:
+    /// A node pair; `next` > 0 resumes the expansion of an already visited pair at that child.
     struct Entry {
-        std::uint32_t a, b;
+        std::uint32_t a, b, next;
     };
     explicit PairStack(std::size_t capacity) : capacity_(std::max(capacity, local_capacity)) {
         if (capacity > local_capacity) {
@@ -187,9 +188,9 @@ public:
             data_ = heap_.get();
         }
     }
-    void push(std::uint32_t ia, std::uint32_t ib) {
+    void push(std::uint32_t ia, std::uint32_t ib, std::uint32_t next = 0) {
         HBVH_ASSERT(size_ < capacity_);
-        data_[size_++] = {ia, ib};
+        data_[size_++] = {ia, ib, next};
     }
     [[nodiscard]] bool empty() const { return size_ == 0; }
     Entry pop() { return data_[--size_]; }

@@ -25,47 +25,63 @@ public:
     void run() {
         if (!roots_meet()) return;
         // Depth-first over overlapping pairs. Every pair on the stack is known to overlap, and no pair of
-        // leaves is ever pushed: those are reported when their test passes. The stack holds at most the
-        // unexpanded siblings along one root-to-leaf path of each tree.
-        detail::PairStack stack(std::size_t{a_.stack_bound()} + b_.stack_bound() + 1);
+        // leaves is ever pushed: those are reported when their test passes. In mode all the stack holds at
+        // most the unexpanded siblings along one root-to-leaf path of each tree.
+        // In mode first, any contact ends the query, so an expansion stops at the first child that meets the
+        // other node and descends into it at once, leaving a resume entry for its siblings: two entries per
+        // level (a stack bound is at least the depth), and about one test per level to the first contact
+        // where the objects overlap deeply, instead of every child of every level.
+        const bool depth_first = mode_ == CollideMode::first;
+        const std::size_t bounds = std::size_t{a_.stack_bound()} + b_.stack_bound();
+        detail::PairStack stack((depth_first ? 2 * bounds : bounds) + 1);
         stack.push(0, 0);
         while (!stack.empty()) {
-            const auto [ia, ib] = stack.pop();
-            ++result_.nodes_visited;
+            const auto [ia, ib, next] = stack.pop();
             const QueryNode& x = na_[ia];
             const QueryNode& y = nb_[ib];
-            if (std::uint64_t{x.leaf_count} * y.leaf_count <= flat_limit_) {
-                if (flat(x, y)) return;
-                continue;
+            if (next == 0) {  // a new pair, not a resumed one
+                ++result_.nodes_visited;
+                if (std::uint64_t{x.leaf_count} * y.leaf_count <= flat_limit_) {
+                    if (flat(x, y)) return;
+                    continue;
+                }
             }
             // Erleben et al.: descend the larger volume, so both trees shrink at about the same pace.
             if (y.child_count == 0 || (x.child_count != 0 && x.measure >= y.measure)) {
                 Placed placed(y, t_);  // y moved once for all of x's children
-                for (std::uint32_t c = x.first_child; c < x.first_child + x.child_count; ++c) {
+                const std::uint32_t end = x.first_child + x.child_count;
+                for (std::uint32_t c = next != 0 ? next : x.first_child; c < end; ++c) {
                     const QueryNode& child = na_[c];
                     if (child.child_count == 0 && y.child_count == 0) {
                         if (leaf_pair(c, ib, placed.center()) && found(c, ib)) return;
                         continue;
                     }
                     ++result_.bv_tests;
-                    if (detail::spheres_meet(child, placed.center(), y.sphere_radius) &&
-                        detail::boxes_meet(child, y, placed, slack_))
-                        stack.push(c, ib);
+                    if (!detail::spheres_meet(child, placed.center(), y.sphere_radius) ||
+                        !detail::boxes_meet(child, y, placed, slack_))
+                        continue;
+                    if (depth_first && c + 1 < end) stack.push(ia, ib, c + 1);
+                    stack.push(c, ib);
+                    if (depth_first) break;
                 }
             } else {
                 // x stays put: it is moved into b's frame once, so that each child of y is tested in its own
                 // model frame with no motion of its own.
                 Placed placed(x, t_inverse_);
-                for (std::uint32_t c = y.first_child; c < y.first_child + y.child_count; ++c) {
+                const std::uint32_t end = y.first_child + y.child_count;
+                for (std::uint32_t c = next != 0 ? next : y.first_child; c < end; ++c) {
                     const QueryNode& child = nb_[c];
                     if (child.child_count == 0 && x.child_count == 0) {
                         if (leaf_pair(ia, c, moved_.center(c)) && found(ia, c)) return;
                         continue;
                     }
                     ++result_.bv_tests;
-                    if (detail::spheres_meet(child, placed.center(), x.sphere_radius) &&
-                        detail::boxes_meet(child, x, placed, slack_))
-                        stack.push(ia, c);
+                    if (!detail::spheres_meet(child, placed.center(), x.sphere_radius) ||
+                        !detail::boxes_meet(child, x, placed, slack_))
+                        continue;
+                    if (depth_first && c + 1 < end) stack.push(ia, ib, c + 1);
+                    stack.push(ia, c);
+                    if (depth_first) break;
                 }
             }
         }
