@@ -252,10 +252,22 @@ def peers_summary(path):
     if loses:
         print('FCL\'s traversal alone (without moving its n objects, which a rigid compound would not need) is '
               'faster than hbvh on: ' + ', '.join(loses) + '.')
-    flat = [f'{r["object"]} {r["regime"]}' for r in queries if number(r['hbvh 2-level']) < number(r['hbvh'])]
-    if flat:
-        print(f'hbvh\'s own two-level query beats its tandem traversal on {len(flat)} of {len(queries)} rows '
-              f'(e.g. {", ".join(flat[:4])}).')
+    # Issue 13's bars against hbvh's own two-level query: <= 0.8x when partly overlapping or near, <= 1.2x
+    # at total overlap, in both modes.
+    def bar(r): return 1.2 if r['regime'] == 'total' else 0.8
+    for mode, column in (('all', 'tandem/2-level'), ('first', 'tandem/2-level first')):
+        if not queries or column not in queries[0]: continue
+        parts = []
+        for regime in dict.fromkeys(r['regime'] for r in queries):
+            rs = [number(r[column]) for r in queries if r['regime'] == regime]
+            parts.append(f'{regime} {span(rs, "{:.2f}")}')
+        miss = [f'{r["object"]} {r["regime"]} ({number(r[column]):.2f})' for r in queries if number(r[column]) > bar(r)]
+        print(f'Tandem traversal / two-level query, mode {mode}: ' + '; '.join(parts) + '. '
+              + (f'Above the bar (0.8, total 1.2) on {len(miss)} of {len(queries)} rows: {", ".join(miss)}.' if miss
+                 else 'Within the bar (0.8, total 1.2) on every row.'))
+    below = [f'{r["object"]} {r["regime"]} ({h[0]:.2f})' for h in honest for r in [h[3]] if h[0] < 2.0]
+    if below:
+        print(f'Faster peer / hbvh below 2 on {len(below)} of {len(queries)} rows: {", ".join(below)}.')
     if builds:
         bt = [number(r['hbvh ms']) / max(number(r['bullet ms']), 1e-9) for r in builds]
         cost = [number(r['hbvh cost']) / number(r['bullet cost']) for r in builds]
