@@ -15,9 +15,13 @@ namespace hbvh::detail {
 namespace {
 
 /// Smallest width of a convex polygon (counter-clockwise, no repeated points): attained perpendicular to
-/// one of its edges, so the widths across the edges are the only ones tried. O(h^2); h stays small.
-double min_width(const std::vector<Eigen::Vector2d>& hull) {
+/// one of its edges, so the widths across the edges are the only ones tried. Brute force over every vertex
+/// for small polygons, the antipodal vertex by rotating calipers above (a flat ring of 10^5 spheres has a
+/// 2-D hull of 10^5 points, and the brute force was quadratic in it).
+double min_width(const std::vector<Eigen::Vector2d>& hull, std::vector<EdgeExtremes>& extremes) {
     if (hull.size() < 3) return 0.0;  // a segment or a point has no width
+    const bool brute_force = hull.size() <= calipers_above;
+    if (!brute_force) edge_extremes(hull, extremes);
     double best = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < hull.size(); ++i) {
         const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
@@ -25,7 +29,11 @@ double min_width(const std::vector<Eigen::Vector2d>& hull) {
         if (!(length > 0.0)) continue;
         const Eigen::Vector2d normal(-edge.y() / length, edge.x() / length);
         double far = 0.0;
-        for (const Eigen::Vector2d& p : hull) far = std::max(far, std::abs((p - hull[i]).dot(normal)));
+        if (brute_force) {
+            for (const Eigen::Vector2d& p : hull) far = std::max(far, std::abs((p - hull[i]).dot(normal)));
+        } else {
+            far = std::abs((hull[extremes[i].farthest_across] - hull[i]).dot(normal));
+        }
         best = std::min(best, far);
     }
     return std::isfinite(best) ? best : 0.0;
@@ -109,6 +117,7 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     double radius = max_radius;
     std::vector<Eigen::Vector2d> projected;
     std::vector<Eigen::Vector2d> hull;
+    std::vector<EdgeExtremes> extremes;
     projected.reserve(proxy.hull_points.size());
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
@@ -119,7 +128,7 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
                 projected.emplace_back(d.dot(basis.col(1)), d.dot(basis.col(2)));
             }
             hull_2d(projected, hull);
-            radius = std::max(radius, 0.5 * min_width(hull) + min_radius);
+            radius = std::max(radius, 0.5 * min_width(hull, extremes) + min_radius);
             // The bound only grows from here; once it is enough the other planes cannot change the answer.
             if (volume_at(radius) >= enough) return volume_at(radius);
         }

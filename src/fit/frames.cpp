@@ -205,6 +205,7 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     const double pad = 2.0 * proxy.max_radius;
     std::vector<Eigen::Vector2d> projected;
     std::vector<Eigen::Vector2d> hull;
+    std::vector<EdgeExtremes> extremes;
     projected.reserve(proxy.hull_points.size());
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
@@ -213,18 +214,30 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
         projected.clear();
         for (const Vec3& p : proxy.hull_points) projected.emplace_back(p.dot(basis.col(1)), p.dot(basis.col(2)));
         hull_2d(projected, hull);
-        // Try each hull edge as a rectangle side; O(h^2) in the 2-D hull size, which stays small.
+        // Try each hull edge as a rectangle side: over every vertex for small hulls (O(h^2), exact), by
+        // rotating calipers above (O(h); a flat ring of 10^5 spheres projects to a 2-D hull of 10^5 points).
+        const bool brute_force = hull.size() <= calipers_above;
+        if (!brute_force) edge_extremes(hull, extremes);
         Eigen::Vector2d best_direction(1.0, 0.0);
         double best_area = infinity;
         for (std::size_t i = 0; i < hull.size(); ++i) {
-            const Eigen::Vector2d edge = hull[(i + 1) % hull.size()] - hull[i];
+            const std::size_t next = (i + 1) % hull.size();
+            const Eigen::Vector2d edge = hull[next] - hull[i];
             if (!(edge.norm() > 0.0)) continue;
             const Eigen::Vector2d d = edge.normalized();
             const Eigen::Vector2d perpendicular(-d.y(), d.x());
             double low_d = infinity, high_d = -infinity, low_p = infinity, high_p = -infinity;
-            for (const Eigen::Vector2d& q : hull) {
-                low_d = std::min(low_d, q.dot(d)), high_d = std::max(high_d, q.dot(d));
-                low_p = std::min(low_p, q.dot(perpendicular)), high_p = std::max(high_p, q.dot(perpendicular));
+            if (brute_force) {
+                for (const Eigen::Vector2d& q : hull) {
+                    low_d = std::min(low_d, q.dot(d)), high_d = std::max(high_d, q.dot(d));
+                    low_p = std::min(low_p, q.dot(perpendicular)), high_p = std::max(high_p, q.dot(perpendicular));
+                }
+            } else {
+                // Every vertex lies on the inner side of the edge's line, so the edge's ends are lowest across it.
+                const EdgeExtremes& e = extremes[i];
+                low_d = hull[e.lowest_along].dot(d), high_d = hull[e.highest_along].dot(d);
+                low_p = std::min(hull[i].dot(perpendicular), hull[next].dot(perpendicular));
+                high_p = hull[e.farthest_across].dot(perpendicular);
             }
             const double area = (high_d - low_d + pad) * (high_p - low_p + pad);
             if (area < best_area) best_area = area, best_direction = d;

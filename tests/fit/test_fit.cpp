@@ -529,5 +529,49 @@ TEST(Fit, LargeSetStaysFast) {
     expect_contains_all(fit_sphere(set.spheres), set, "sphere");
 }
 
+TEST(Fit, FitInputKeepsEachOrientationOnceInOrder) {
+    SplitMix64 rng(4242);
+    const Mat3 first = rng.rotation();
+    const Mat3 second = rng.rotation();
+    Mat3 near_first = first;
+    near_first(0, 1) += 1e-13;  // a rounding-level difference: the same orientation
+    FitInput input;
+    for (const Mat3& rotation : {first, second, first, near_first, second}) input.add(Obb{Vec3(1, 2, 3), rotation, Vec3(1, 2, 3)});
+    input.add(Sphere{Vec3(0, 0, 0), 1.0});  // no axes
+    ASSERT_EQ(input.hint_axes.size(), 2u);
+    EXPECT_EQ(input.hint_axes[0], first);
+    EXPECT_EQ(input.hint_axes[1], second);
+    EXPECT_EQ(input.spheres.size(), 5u * 8u + 1u);  // every volume's generating spheres, repeats included
+}
+
+TEST(Fit, FitInputCapsItsHintAxes) {
+    SplitMix64 rng(77);
+    std::vector<Mat3> rotations;
+    for (std::size_t i = 0; i < 3 * FitInput::max_hint_axes; ++i) rotations.push_back(rng.rotation());
+    FitInput input;
+    for (const Mat3& rotation : rotations) input.add(Obb{Vec3::Zero(), rotation, Vec3(1, 1, 1)});
+    ASSERT_EQ(input.hint_axes.size(), FitInput::max_hint_axes);
+    for (std::size_t i = 0; i < FitInput::max_hint_axes; ++i) EXPECT_EQ(input.hint_axes[i], rotations[i]) << i;
+    EXPECT_EQ(input.spheres.size(), rotations.size() * 8u);
+}
+
+TEST(Fit, FlatRingWithABigHullFitsTightly) {
+    // A ring of spheres in a tilted plane: every centre is on the 2-D hull, so the face-flush frames and the
+    // capsule bound take their rotating-calipers path. The box must be the ring's flat square and hold it all.
+    const Mat3 frame = SplitMix64(9).rotation();
+    SphereSet ring{"ring", {}, {}};
+    const std::size_t count = 3000;
+    for (std::size_t i = 0; i < count; ++i) {
+        const double t = 2.0 * std::numbers::pi * static_cast<double>(i) / static_cast<double>(count);
+        ring.spheres.push_back({Vec3(5, -2, 7) + frame * Vec3(10.0 * std::cos(t), 10.0 * std::sin(t), 0.0), 0.5});
+    }
+    const Obb box = fit_obb(ring.spheres);
+    expect_contains_all(box, ring, "obb");
+    EXPECT_LT(box.volume(), 21.0 * 21.0 * 1.0 * (1.0 + 1e-3));
+    const Capsule capsule = fit_capsule(ring.spheres);
+    expect_contains_all(capsule, ring, "capsule");
+    expect_contains_all(fit_best(ring.spheres, VolumePolicy{}), ring, "best");
+}
+
 }  // namespace
 }  // namespace hbvh

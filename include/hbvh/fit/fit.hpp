@@ -6,7 +6,11 @@
 // every fitter, for leaves and inner nodes alike.
 #pragma once
 
+#include <array>
+#include <cstddef>
+#include <cstdint>
 #include <span>
+#include <unordered_set>
 #include <vector>
 
 #include "hbvh/fit/volume_policy.hpp"
@@ -35,10 +39,27 @@ namespace hbvh {
                                       std::span<const Mat3> hint_axes = {});
 
 /// Convenience: generating spheres and box axes of a set of primitives, ready for the fitters.
+/// add() is O(1) per volume (amortised), so gathering n primitives is O(n).
 struct FitInput {
+    /// At most this many hint axes are kept: the first distinct orientations in the order added. The
+    /// fitters rank every hint over the hull points and keep the best 8 (O(hints x hull) per fit), and the
+    /// orientations of a few of many differently oriented boxes rarely shape a box around all of them.
+    /// 64 is above the distinct orientations of every bundled model, so their fits keep every hint.
+    static constexpr std::size_t max_hint_axes = 64;
+
     std::vector<Sphere> spheres;
-    std::vector<Mat3> hint_axes;  ///< Rotations of the covered OBBs (deduplicated loosely).
+    /// Rotations of the covered OBBs, first occurrences in order, deduplicated loosely (two rotations whose
+    /// entries round to the same multiple of 1e-9 count as one; exact repeats always do), at most max_hint_axes.
+    std::vector<Mat3> hint_axes;
     void add(const BoundingVolume& bv);
+
+private:
+    /// A rotation's entries rounded to multiples of 1e-9: the dedupe key.
+    using AxesKey = std::array<std::int64_t, 9>;
+    struct AxesKeyHash {
+        std::size_t operator()(const AxesKey& key) const noexcept;
+    };
+    std::unordered_set<AxesKey, AxesKeyHash> seen_axes_;
 };
 
 }  // namespace hbvh
