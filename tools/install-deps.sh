@@ -9,7 +9,7 @@ packages=(
   libcgal-dev libqhull-dev libtbb-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev libccd-dev
   libmujoco-dev libmujoco-samples liburdfdom-dev libassimp-dev
-  libbullet-dev libfcl-dev graphviz
+  libbullet-dev libfcl-dev libembree-dev graphviz
   chromium
   clang-16 libclang-rt-16-dev
   pybind11-dev python3-dev python3-numpy python3-pytest

@@ -1,0 +1,218 @@
+// SPDX-License-Identifier: MIT
+// The speed anchor for large scenes: Embree's rtcBuildBVH (binned SAH, binary AABB nodes, one primitive
+// per leaf, two threads) over the primitives' world AABBs, side by side with hbvh's split and scale limited
+// to AABBs, on the `hbvh generate --seed 1` scenes of 20 000 and 10^6 primitives. Embree's tree is measured
+// with the same Eq. 2 cost: sum over inner nodes of child count x volume of the node's AABB, each node's box
+// recomputed in double as the union of its primitives' world boxes (Embree's own bounds are floats).
+// Built only when CMake finds Embree (bench/CMakeLists.txt).
+//
+//   hbvh_bench --benchmark_filter='embree_anchor/20k'    (seconds; prints a table)
+//   hbvh_bench --benchmark_filter='embree_anchor/1M'     (minutes: split and scale at 10^6)
+#include <benchmark/benchmark.h>
+#include <embree3/rtcore.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <new>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "hbvh/builders/build.hpp"
+#include "hbvh/fit/volume_policy.hpp"
+#include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/stats.hpp"
+
+namespace hbvh::bench {
+void fail(benchmark::State& state, const std::string& message);
+}  // namespace hbvh::bench
+
+namespace hbvh {
+namespace {
+
+/// A node of the recorded tree, allocated by Embree's thread-local allocator. Inner nodes and leaves
+/// share the layout so that a child pointer says which it is.
+struct RecordedNode {
+    bool is_leaf = false;
+    std::uint32_t child_count = 0;
+    RecordedNode* children[2] = {nullptr, nullptr};
+    std::uint32_t primitive = 0;      ///< leaves: the one primitive (minLeafSize = maxLeafSize = 1)
+    std::uint32_t extra_primitives = 0;  ///< leaves that Embree filled with more than one (expected none)
+};
+
+void* create_node(RTCThreadLocalAllocator allocator, unsigned int child_count, void* /*user*/) {
+    void* memory = rtcThreadLocalAlloc(allocator, sizeof(RecordedNode), alignof(RecordedNode));
+    auto* node = new (memory) RecordedNode;
+    node->child_count = child_count;
+    return node;
+}
+
+void set_children(void* node_pointer, void** children, unsigned int child_count, void* /*user*/) {
+    auto* node = static_cast<RecordedNode*>(node_pointer);
+    node->child_count = child_count;
+    for (unsigned int i = 0; i < child_count && i < 2; ++i) node->children[i] = static_cast<RecordedNode*>(children[i]);
+}
+
+void set_bounds(void* /*node*/, const RTCBounds** /*bounds*/, unsigned int /*child_count*/, void* /*user*/) {
+    // The cost is recomputed in double from the primitives, so Embree's float bounds are not kept.
+}
+
+void* create_leaf(RTCThreadLocalAllocator allocator, const RTCBuildPrimitive* primitives, size_t count, void* /*user*/) {
+    void* memory = rtcThreadLocalAlloc(allocator, sizeof(RecordedNode), alignof(RecordedNode));
+    auto* leaf = new (memory) RecordedNode;
+    leaf->is_leaf = true;
+    leaf->primitive = primitives[0].primID;
+    leaf->extra_primitives = static_cast<std::uint32_t>(count - 1);
+    return leaf;
+}
+
+/// Embree's input: each primitive's world AABB rounded outwards to float.
+std::vector<RTCBuildPrimitive> embree_primitives(std::span<const Primitive> primitives) {
+    std::vector<RTCBuildPrimitive> out(primitives.size());
+    const auto down = [](double x) {
+        const float f = static_cast<float>(x);
+        return static_cast<double>(f) > x ? std::nextafter(f, -INFINITY) : f;
+    };
+    const auto up = [](double x) {
+        const float f = static_cast<float>(x);
+        return static_cast<double>(f) < x ? std::nextafter(f, INFINITY) : f;
+    };
+    for (std::size_t i = 0; i < primitives.size(); ++i) {
+        const Aabb box = world_aabb(primitives[i].volume);
+        out[i] = {down(box.min.x()), down(box.min.y()), down(box.min.z()), 0u,
+                  up(box.max.x()),   up(box.max.y()),   up(box.max.z()),   static_cast<unsigned>(i)};
+    }
+    return out;
+}
+
+/// What a walk of the recorded tree finds.
+struct TreeMeasure {
+    double cost = 0.0;           ///< AABB Eq. 2
+    std::size_t leaves = 0;
+    std::size_t extra_primitives = 0;
+    std::vector<std::uint32_t> seen;  ///< how often each primitive is in a leaf
+};
+
+/// The node's AABB (union of its primitives' world boxes), adding its Eq. 2 term when it is inner.
+Aabb measure(const RecordedNode* node, std::span<const Aabb> boxes, TreeMeasure& out) {
+    if (node->is_leaf) {
+        ++out.leaves;
+        out.extra_primitives += node->extra_primitives;
+        if (node->primitive < out.seen.size()) ++out.seen[node->primitive];
+        return boxes[node->primitive];
+    }
+    Aabb box = Aabb::empty();
+    for (std::uint32_t i = 0; i < node->child_count && i < 2; ++i) box = box.merged(measure(node->children[i], boxes, out));
+    out.cost += static_cast<double>(node->child_count) * box.volume();
+    return box;
+}
+
+struct Row {
+    std::string builder;
+    double seconds = 0.0;
+    double cost = 0.0;
+};
+
+void embree_anchor(benchmark::State& state, std::uint32_t count) {
+    SceneOptions options;
+    options.count = count;
+    options.seed = 1;
+    const std::vector<Primitive> primitives = generate_scene(options);
+    std::vector<Aabb> boxes;
+    boxes.reserve(primitives.size());
+    for (const Primitive& p : primitives) boxes.push_back(world_aabb(p.volume));
+    const std::vector<RTCBuildPrimitive> input = embree_primitives(primitives);
+
+    RTCDevice device = rtcNewDevice("threads=2");
+    if (device == nullptr) {
+        bench::fail(state, "rtcNewDevice failed");
+        return;
+    }
+    std::vector<Row> rows;
+    // Embree: the fastest of a few builds (it takes milliseconds at 20 000), each on a fresh copy of the
+    // primitive array, which the builder uses as scratch space.
+    const int repeats = count <= 100'000 ? 5 : 3;
+    Row embree{"embree rtcBuildBVH", 0.0, 0.0};
+    for (auto _ : state) {
+        for (int r = 0; r < repeats; ++r) {
+            std::vector<RTCBuildPrimitive> scratch = input;
+            RTCBVH bvh = rtcNewBVH(device);
+            RTCBuildArguments arguments = rtcDefaultBuildArguments();
+            arguments.buildQuality = RTC_BUILD_QUALITY_MEDIUM;  // binned SAH, no spatial splits
+            arguments.maxBranchingFactor = 2;
+            arguments.maxDepth = 1024;
+            arguments.minLeafSize = 1;
+            arguments.maxLeafSize = 1;
+            arguments.bvh = bvh;
+            arguments.primitives = scratch.data();
+            arguments.primitiveCount = scratch.size();
+            arguments.primitiveArrayCapacity = scratch.size();
+            arguments.createNode = create_node;
+            arguments.setNodeChildren = set_children;
+            arguments.setNodeBounds = set_bounds;
+            arguments.createLeaf = create_leaf;
+            const auto start = std::chrono::steady_clock::now();
+            const auto* root = static_cast<const RecordedNode*>(rtcBuildBVH(&arguments));
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            if (root == nullptr) {
+                bench::fail(state, "rtcBuildBVH failed: error " + std::to_string(rtcGetDeviceError(device)));
+                rtcReleaseBVH(bvh);
+                rtcReleaseDevice(device);
+                return;
+            }
+            TreeMeasure tree;
+            tree.seen.assign(primitives.size(), 0);
+            measure(root, boxes, tree);
+            rtcReleaseBVH(bvh);
+            // A tree that lost or repeated a primitive would make its cost meaningless.
+            if (tree.extra_primitives != 0 || tree.leaves != primitives.size() ||
+                std::any_of(tree.seen.begin(), tree.seen.end(), [](std::uint32_t n) { return n != 1; })) {
+                bench::fail(state, "Embree's tree does not hold each primitive in its own leaf");
+                rtcReleaseDevice(device);
+                return;
+            }
+            embree.seconds = r == 0 ? seconds : std::min(embree.seconds, seconds);
+            embree.cost = tree.cost;
+        }
+    }
+    rtcReleaseDevice(device);
+    rows.push_back(embree);
+
+    // hbvh, every inner node an AABB (`--types aabb`), once each: the builders take seconds to minutes here.
+    BuildContext context;
+    context.policy = parse_allowed_types("aabb").value();
+    for (const auto& [name, algorithm] : {std::pair{"hbvh split --types aabb", Algorithm::split},
+                                          std::pair{"hbvh scale --types aabb", Algorithm::scale}}) {
+        const auto start = std::chrono::steady_clock::now();
+        const Result<Bvh> built = build(primitives, algorithm, context);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        if (!built.has_value()) {
+            bench::fail(state, std::string(name) + ": " + built.error().to_string());
+            return;
+        }
+        rows.push_back({name, seconds, cost(built.value())});
+    }
+
+    std::printf("\n%u primitives (hbvh generate --count %u --seed 1), AABB Eq. 2 cost\n", count, count);
+    std::printf("| builder | build time (s) | cost | time / Embree | cost / Embree |\n|---|---|---|---|---|\n");
+    for (const Row& row : rows)
+        std::printf("| %s | %.4g | %.4g | %.1f | %.3f |\n", row.builder.c_str(), row.seconds, row.cost,
+                    row.seconds / embree.seconds, row.cost / embree.cost);
+    std::fflush(stdout);
+    state.counters["primitives"] = count;
+    state.counters["embree_seconds"] = embree.seconds;
+    state.counters["embree_cost"] = embree.cost;
+    state.counters["split_seconds"] = rows[1].seconds;
+    state.counters["split_cost_ratio"] = rows[1].cost / embree.cost;
+    state.counters["scale_seconds"] = rows[2].seconds;
+    state.counters["scale_cost_ratio"] = rows[2].cost / embree.cost;
+}
+
+BENCHMARK_CAPTURE(embree_anchor, 20k, 20'000u)->Unit(benchmark::kSecond)->Iterations(1);
+BENCHMARK_CAPTURE(embree_anchor, 1M, 1'000'000u)->Unit(benchmark::kSecond)->Iterations(1);
+
+}  // namespace
+}  // namespace hbvh
