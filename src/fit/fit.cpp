@@ -137,15 +137,6 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
     return *best;
 }
 
-std::size_t FitInput::AxesKeyHash::operator()(const AxesKey& key) const noexcept {
-    // FNV-1a over the nine entries, then a splitmix64 finaliser so that nearby keys spread over buckets.
-    std::uint64_t h = 0xcbf29ce484222325ULL;
-    for (const std::int64_t entry : key) h = (h ^ static_cast<std::uint64_t>(entry)) * 0x100000001b3ULL;
-    h = (h ^ (h >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    h = (h ^ (h >> 27)) * 0x94d049bb133111ebULL;
-    return static_cast<std::size_t>(h ^ (h >> 31));
-}
-
 void FitInput::add(const BoundingVolume& bv) {
     append_generating_spheres(bv, spheres);
     const Obb* box = std::get_if<Obb>(&bv);
@@ -153,16 +144,11 @@ void FitInput::add(const BoundingVolume& bv) {
     // every box with every kept one was O(n^2) over a scene of differently oriented boxes: 75 % of a 10^6
     // primitive two-level build.)
     if (box == nullptr || hint_axes.size() >= max_hint_axes) return;
-    // Boxes that share an orientation (common in artists' models) would only repeat work. The grid of 1e-9
-    // is the tolerance of the earlier pairwise test (|a - b| < 1e-9 per entry); a valid rotation's entries
-    // lie in [-1, 1], and clamping keeps the rounding defined for anything else.
-    AxesKey key{};
-    for (int i = 0; i < 9; ++i) {
-        const double entry = box->rotation(i / 3, i % 3);
-        key[static_cast<std::size_t>(i)] =
-            std::isnan(entry) ? std::numeric_limits<std::int64_t>::min() : std::llround(std::clamp(entry, -2.0, 2.0) * 1e9);
-    }
-    if (seen_axes_.insert(key).second) hint_axes.push_back(box->rotation);
+    // Boxes that share an orientation (common in artists' models) would only repeat work. With the cap,
+    // comparing with every kept orientation is at most max_hint_axes comparisons and allocates nothing.
+    for (const Mat3& axes : hint_axes)
+        if ((axes - box->rotation).cwiseAbs().maxCoeff() < 1e-9) return;
+    hint_axes.push_back(box->rotation);
 }
 
 }  // namespace hbvh

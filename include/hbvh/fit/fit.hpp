@@ -6,11 +6,8 @@
 // every fitter, for leaves and inner nodes alike.
 #pragma once
 
-#include <array>
 #include <cstddef>
-#include <cstdint>
 #include <span>
-#include <unordered_set>
 #include <vector>
 
 #include "hbvh/fit/volume_policy.hpp"
@@ -39,7 +36,7 @@ namespace hbvh {
                                       std::span<const Mat3> hint_axes = {});
 
 /// Convenience: generating spheres and box axes of a set of primitives, ready for the fitters.
-/// add() is O(1) per volume (amortised), so gathering n primitives is O(n).
+/// add() is O(max_hint_axes) = O(1) per volume, so gathering n primitives is O(n).
 struct FitInput {
     /// At most this many hint axes are kept: the first distinct orientations in the order added. The
     /// fitters rank every hint over the hull points and keep the best 8 (O(hints x hull) per fit), and the
@@ -49,17 +46,9 @@ struct FitInput {
 
     std::vector<Sphere> spheres;
     /// Rotations of the covered OBBs, first occurrences in order, deduplicated loosely (two rotations whose
-    /// entries round to the same multiple of 1e-9 count as one; exact repeats always do), at most max_hint_axes.
+    /// entries all differ by less than 1e-9 count as one), at most max_hint_axes.
     std::vector<Mat3> hint_axes;
     void add(const BoundingVolume& bv);
-
-private:
-    /// A rotation's entries rounded to multiples of 1e-9: the dedupe key.
-    using AxesKey = std::array<std::int64_t, 9>;
-    struct AxesKeyHash {
-        std::size_t operator()(const AxesKey& key) const noexcept;
-    };
-    std::unordered_set<AxesKey, AxesKeyHash> seen_axes_;
 };
 
 }  // namespace hbvh
