@@ -447,6 +447,82 @@ TEST(BinaryFormat, HugeCountsAreRefusedBeforeAllocating) {
     }
 }
 
+/// The size of a volume record of `volume`, from the layout table of docs/formats.md (not from the reader).
+std::size_t record_size(const BoundingVolume& volume) {
+    constexpr std::size_t doubles[] = {6, 15, 4, 7};
+    return 1 + 8 * doubles[volume.index()];
+}
+
+// A file of a few megabytes takes the reader's other path: mapped rather than read, and decoded by two tasks at
+// once (the checksum and the nodes, the primitives). It must load the same tree and name the same first problem
+// in file order as the small files above.
+TEST(BinaryFormat, LargeFilesLoadTheSameAndReportTheFirstProblemInFileOrder) {
+    const Bvh original = built(named_scene(12000, 11), Algorithm::two_level);
+    const std::string bytes = write_binary(original);
+    ASSERT_GT(bytes.size(), std::size_t{1} << 20);  // past both thresholds of the reader
+    Result<Bvh> back = read(bytes);
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    expect_same(original, back.value());
+
+    const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "hbvh_binary_large_test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::filesystem::path file = dir / "large.hbvh";
+    ASSERT_TRUE(write_binary_file(file, original));
+    back = read_binary_file(file);
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    expect_same(original, back.value());
+
+    // Where the records are, by the layout: the last node's record, the primitives' first and last.
+    std::size_t last_node_at = 40;
+    for (std::size_t i = 0; i + 1 < original.nodes.size(); ++i) last_node_at += record_size(original.nodes[i].volume) + 12;
+    const std::size_t primitives_at = last_node_at + record_size(original.nodes.back().volume) + 12;
+    std::size_t last_primitive_at = primitives_at;
+    for (std::size_t i = 0; i + 1 < original.primitives.size(); ++i) last_primitive_at += record_size(original.primitives[i].volume);
+    const std::size_t last = original.primitives.size() - 1;
+
+    // An unknown kind in the last primitive record alone, then also in the last node record: the node is first.
+    std::string bad_kind = bytes;
+    bad_kind[last_primitive_at] = 7;
+    reseal(bad_kind);
+    back = read(bad_kind);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset " + std::to_string(last_primitive_at) + ": unknown volume kind 7", 0), 0u)
+        << back.error().message;
+    bad_kind[last_node_at] = 8;
+    reseal(bad_kind);
+    back = read(bad_kind);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset " + std::to_string(last_node_at) + ": unknown volume kind 8", 0), 0u)
+        << back.error().message;
+    // Not resealed, the same edits are a corrupted file, whatever they would have been behind a good checksum.
+    bad_kind[last_node_at + 3] ^= 0x10;
+    back = read(bad_kind);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_NE(back.error().message.find("checksum mismatch"), std::string::npos) << back.error().message;
+
+    // A negative radius in the last primitive: found on the fly, then worded by validate_primitives.
+    Bvh negative = original;
+    std::visit([](auto& volume) {
+        if constexpr (requires { volume.radius; }) volume.radius = -1.0;
+        else if constexpr (requires { volume.half_extents; }) volume.half_extents.x() = -1.0;
+        else volume.max.x() = volume.min.x() - 1.0;
+    }, negative.primitives[last].volume);
+    back = read(write_binary(negative));
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset " + std::to_string(last_primitive_at) + ": primitive " + std::to_string(last), 0), 0u)
+        << back.error().message;
+
+    // An impossible node count: named after the checksum, before anything is decoded.
+    std::string bad_count = bytes;
+    store_u64(bad_count, 24, bytes.size());
+    reseal(bad_count);
+    back = read(bad_count);
+    ASSERT_FALSE(back.has_value());
+    EXPECT_EQ(back.error().message.rfind("offset 24: node count", 0), 0u) << back.error().message;
+    std::filesystem::remove_all(dir);
+}
+
 TEST(BinaryFormat, FileHelpersWriteAtomicallyAndNameTheFile) {
     const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "hbvh_binary_format_test";
     std::filesystem::remove_all(dir);
