@@ -5,6 +5,7 @@
 #include <span>
 
 #include "hbvh/builders/auto.hpp"
+#include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/bnb_enlarge.hpp"
 #include "hbvh/builders/bnb_exact.hpp"
 #include "hbvh/builders/bnb_tightest.hpp"

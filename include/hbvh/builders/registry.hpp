@@ -28,6 +28,7 @@ enum class Algorithm {
     split,
     obb_tree,
     scale,
+    binned,
     automatic,  ///< "auto"
 };
 

@@ -1,0 +1,54 @@
+// SPDX-License-Identifier: MIT
+// binned: the large-scene builder — top-down binned splits on the volume heuristic, then the Eq. 2-optimal
+// collapse of that binary tree into wide nodes (docs/scale.md §9).
+#pragma once
+
+#include <cstdint>
+#include <span>
+
+#include "hbvh/builders/context.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+/// Knobs of build_binned. The defaults are the measured compromise (docs/scale.md §9).
+struct BinnedOptions {
+    /// Ranges of more than `sweep_max_primitives` primitives are cut between centroid bins: this many per
+    /// axis, each cut priced as count(left) x volume(left) + count(right) x volume(right) of the sides' boxes.
+    std::uint32_t bin_count = 32;
+    /// Ranges of at most this many primitives try every cut of their centres sorted along x, y and z.
+    std::uint32_t sweep_max_primitives = 16;
+    /// The most children a node of the result may have (2..16). The collapse keeps a binary node only where
+    /// that lowers Eq. 2; this bounds how many it may merge into one.
+    std::uint32_t max_children = 8;
+    /// Where OBBs are allowed, kept nodes over at most `hull_fit_max_primitives` primitives try boxes in the
+    /// DiTO frames of their generating spheres, and from `hull_fit_min_primitives` on fit_obb (hull-based)
+    /// over those spheres too; larger nodes fit_obb around their children's volumes (a few dozen points
+    /// however large the node). Every node also has the cheap fits: exact AABB; OBB and capsule in the
+    /// principal frame of its sphere centres; the sphere around its box centre.
+    std::uint32_t hull_fit_min_primitives = 128;
+    std::uint32_t hull_fit_max_primitives = 4096;
+    /// ... but fit_obb over the spheres only for inputs of at most this many primitives: it costs about 0.6 µs
+    /// a sphere (qhull), and at 10^6 primitives the nodes between the two limits hold 2.5·10^7 spheres.
+    std::uint32_t hull_fit_max_input = 200'000;
+    /// Kept nodes over at most this many primitives also try fit_best (every fitter of fit/fit.hpp) over
+    /// their primitives. 0: none (fit_best costs about 0.1 ms a call, the rest of a node's fit a microsecond).
+    std::uint32_t exact_fit_max_primitives = 0;
+};
+
+/// A hierarchy for large scenes (10^4 to 10^6 primitives and more), in O(n log n) and on every core:
+/// 1. a binary tree, top-down: each range of primitives is cut where the two sides' boxes, weighted by their
+///    primitive counts, have the least volume (between `bin_count` centroid bins per axis for large ranges,
+///    between sorted centres for small ones; a range whose recursion grows deeper than 2 log2 n + 32 is cut at
+///    its median instead, which bounds the depth);
+/// 2. each binary node's volume: the cheapest allowed kind of its cheap fit over the generating spheres below;
+/// 3. the collapse: the subset of binary nodes to keep that minimises Eq. 2 exactly, by dynamic programming
+///    over the binary tree with at most `max_children` children per kept node;
+/// 4. the kept nodes' volumes, refitted with fit_best where small.
+/// Deterministic for any thread count (each range is cut by one task, from its contents only).
+/// Deadline: checked at every range; progress: the share of primitives placed.
+[[nodiscard]] Result<Bvh> build_binned(std::span<const Primitive> primitives, const BuildContext& context,
+                                       const BinnedOptions& options = {});
+
+}  // namespace hbvh

@@ -1,0 +1,531 @@
+// SPDX-License-Identifier: MIT
+// binned: top-down binned splits on a volume heuristic, the Eq. 2-optimal collapse into wide nodes, then one
+// fit per kept node (docs/scale.md §9).
+#include "hbvh/builders/binned.hpp"
+
+#include <Eigen/Eigenvalues>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "guarded_build.hpp"
+#include "heuristic_support.hpp"
+#include "hbvh/fit/fit.hpp"
+#include "../fit/frames.hpp"
+
+namespace hbvh {
+namespace binned_internal {  // named, so that a unity build's other anonymous helpers cannot collide
+namespace {
+
+using detail::PrimitiveSet;
+
+constexpr std::uint32_t max_children_limit = 16;
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+double box_area(const Aabb& box) {
+    const Vec3 e = (box.max - box.min).cwiseMax(0.0);
+    return e.x() * e.y() + e.y() * e.z() + e.z() * e.x();
+}
+
+/// What a side of a cut of `count` primitives is expected to add to Eq. 2, per unit of its volume. A subtree
+/// over m primitives whose volume halves from level to level costs about 2 x volume x log2 m (each of its
+/// log2 m levels adds twice the volume it covers), and a single primitive adds nothing of its own. This
+/// weighting made trees 2-3 % cheaper than the count weighting of ray-tracing's surface area heuristic
+/// (count x area), which assumes a cost per primitive in each leaf (docs/scale.md §9).
+double side_weight(double count) { return 2.0 * std::log2(count); }
+
+/// A cut's expected Eq. 2, with the boxes' surface as the tie-breaker: flat scenes (every box of zero volume)
+/// are then still cut where the sides are smallest.
+struct CutCost {
+    double volume = infinity;
+    double area = infinity;
+    [[nodiscard]] bool operator<(const CutCost& other) const {
+        return volume != other.volume ? volume < other.volume : area < other.area;
+    }
+};
+
+/// A primitive as the cuts see it, stored by value so that a range's passes read memory in order.
+struct Ref {
+    Aabb box;                         ///< The primitive's world box.
+    Vec3 centre;
+    std::span<const Sphere> spheres;  ///< The primitive's generating spheres (in the PrimitiveSet).
+    std::uint32_t local = 0;
+};
+
+/// One node of the binary tree: a leaf (one primitive) or a cut of its range in two.
+struct BinaryNode {
+    Aabb box = Aabb::empty();
+    std::uint32_t left = 0, right = 0;  ///< Inner nodes: the children's slots.
+    std::uint32_t begin = 0, end = 0;   ///< The range of refs it covers.
+    bool is_leaf = false;
+};
+
+/// Sums over sphere centres (count, sum, sum of outer products): added up, they give the covariance of any
+/// union of ranges without visiting its spheres again.
+struct Moments {
+    double count = 0.0;
+    Vec3 sum = Vec3::Zero();
+    Mat3 outer = Mat3::Zero();
+    void add(std::span<const Sphere> spheres) {
+        for (const Sphere& s : spheres) {
+            count += 1.0;
+            sum += s.center;
+            outer += s.center * s.center.transpose();
+        }
+    }
+    void add(const Moments& other) {
+        count += other.count;
+        sum += other.sum;
+        outer += other.outer;
+    }
+};
+
+/// A node of the result: a kept binary node and its children (kept nodes or leaves), as slots.
+struct WideNode {
+    std::uint32_t slot = 0;
+    std::uint32_t first_piece = 0;  ///< Its children are pieces_[first_piece, first_piece + piece_count).
+    std::uint32_t piece_count = 0;
+    BoundingVolume volume;
+};
+
+/// A proper rotation whose first column is the main axis of `covariance`, then the second.
+Mat3 principal_axes(const Mat3& covariance) {
+    Eigen::SelfAdjointEigenSolver<Mat3> solver;
+    solver.computeDirect(covariance);
+    Mat3 axes = Mat3::Identity();
+    if (solver.info() != Eigen::Success || !solver.eigenvectors().allFinite()) return axes;
+    const Vec3 x = solver.eigenvectors().col(2).normalized();
+    Vec3 y = solver.eigenvectors().col(1) - solver.eigenvectors().col(1).dot(x) * x;
+    if (!(y.norm() > 1e-9)) return axes;
+    y.normalize();
+    axes.col(0) = x;
+    axes.col(1) = y;
+    axes.col(2) = x.cross(y);
+    return axes;
+}
+
+class BinnedBuilder {
+public:
+    BinnedBuilder(const PrimitiveSet& set, const BinnedOptions& options, const detail::Checkpoint& checkpoint)
+        : set_(set), options_(options), checkpoint_(checkpoint),
+          max_children_(std::clamp(options.max_children, 2u, max_children_limit)), refs_(set.size()),
+          nodes_(2 * std::size_t{set.size()} - 1), best_(nodes_.size() * (max_children_ + 1), infinity),
+          split_(nodes_.size() * (max_children_ + 1), 0) {
+        tbb::parallel_for(tbb::blocked_range<std::uint32_t>(0, set.size(), 4096), [&](const tbb::blocked_range<std::uint32_t>& r) {
+            for (std::uint32_t i = r.begin(); i < r.end(); ++i) {
+                refs_[i].box = fit_aabb(set.spheres(i));
+                refs_[i].centre = set.centre(i);
+                refs_[i].spheres = set.spheres(i);
+                refs_[i].local = i;
+            }
+        });
+        depth_limit_ = static_cast<std::uint32_t>(2.0 * std::log2(static_cast<double>(set.size()) + 1.0)) + 32;
+        const VolumePolicy& policy = set.policy();
+        box_weight_ = policy.is_allowed(BvType::aabb) ? policy.weight_of(BvType::aabb) : 1.0;
+        needs_moments_ = policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule);
+    }
+
+    /// The hierarchy over `primitives` (the PrimitiveSet's input, in input order).
+    Bvh build(std::span<const Primitive> primitives) {
+        const std::uint32_t root = plan(0, static_cast<std::uint32_t>(refs_.size()), 0);
+        Bvh bvh;
+        bvh.primitives.assign(primitives.begin(), primitives.end());
+        if (nodes_[root].is_leaf) {
+            bvh.nodes.push_back(Node{primitives[set_.input_index(refs_[0].local)].volume, 0, 0, set_.input_index(refs_[0].local)});
+            return bvh;
+        }
+        std::vector<WideNode> wide;
+        collect(root, split_of(root)[1], wide);
+        std::vector<double>().swap(best_);  // the collapse is decided: its tables are a fifth of the memory
+        std::vector<std::uint8_t>().swap(split_);
+        fit_all(wide);
+        lay_out(wide, bvh);
+        return bvh;
+    }
+
+private:
+    [[nodiscard]] double* best_of(std::uint32_t slot) { return best_.data() + std::size_t{slot} * (max_children_ + 1); }
+    [[nodiscard]] std::uint8_t* split_of(std::uint32_t slot) { return split_.data() + std::size_t{slot} * (max_children_ + 1); }
+
+    // ---- Step 1: the binary tree, top-down -------------------------------------------------------------
+
+    /// Slots as in split: the leaf at ref position i in slot i, the inner node that cuts before position c
+    /// in slot n - 1 + c; so a node's slot depends on its range only, never on the thread that made it.
+    std::uint32_t plan(std::uint32_t begin, std::uint32_t end, std::uint32_t depth) {
+        if (end - begin == 1) {
+            BinaryNode& leaf = nodes_[begin];
+            leaf = BinaryNode{refs_[begin].box, 0, 0, begin, end, true};
+            best_of(begin)[1] = 0.0;  // a leaf is one child of whichever node it ends up under
+            placed_.fetch_add(1, std::memory_order_relaxed);
+            return begin;
+        }
+        checkpoint_.step(static_cast<double>(placed_.load(std::memory_order_relaxed)));
+        const std::uint32_t cut = begin + choose_cut(std::span(refs_.data() + begin, end - begin), depth);
+        std::uint32_t left = 0, right = 0;
+        constexpr std::uint32_t parallel_above = 4096;  // below, a task costs more than the range
+        if (end - begin > parallel_above)
+            tbb::parallel_invoke([&] { left = plan(begin, cut, depth + 1); }, [&] { right = plan(cut, end, depth + 1); });
+        else
+            left = plan(begin, cut, depth + 1), right = plan(cut, end, depth + 1);
+        const auto slot = static_cast<std::uint32_t>(refs_.size()) - 1 + cut;
+        nodes_[slot] = BinaryNode{nodes_[left].box.merged(nodes_[right].box), left, right, begin, end, false};
+        collapse_costs(slot);
+        return slot;
+    }
+
+    /// Reorders `range` so that the cut falls before the returned position (0 < cut < size).
+    std::uint32_t choose_cut(std::span<Ref> range, std::uint32_t depth) const {
+        if (depth >= depth_limit_) return median_cut(range);
+        if (range.size() <= options_.sweep_max_primitives) return sweep_cut(range);
+        if (const std::uint32_t cut = binned_cut(range); cut != 0) return cut;
+        return median_cut(range);
+    }
+
+    /// Every cut of the centres sorted along x, y and z; the range is left sorted along the best axis.
+    std::uint32_t sweep_cut(std::span<Ref> range) const {
+        const std::size_t count = range.size();
+        std::vector<Aabb> right_sides(count);
+        CutCost best;
+        int best_axis = 0;
+        std::size_t best_cut = count / 2;
+        for (int axis = 0; axis < 3; ++axis) {
+            sort_along(range, axis);
+            Aabb running = Aabb::empty();
+            for (std::size_t i = count; i-- > 0;) right_sides[i] = running = running.merged(range[i].box);
+            running = Aabb::empty();
+            for (std::size_t left = 1; left < count; ++left) {
+                running = running.merged(range[left - 1].box);
+                const CutCost cost = cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides[left]);
+                if (cost < best) best = cost, best_axis = axis, best_cut = left;  // ties: the earlier axis and cut
+            }
+        }
+        if (best_axis != 2) sort_along(range, best_axis);
+        return static_cast<std::uint32_t>(best_cut);
+    }
+
+    /// The best boundary between `bin_count` equal bins of the centres' extent on any axis, with the range
+    /// partitioned there; 0 when the centres fall into one bin on every axis.
+    std::uint32_t binned_cut(std::span<Ref> range) const {
+        Aabb centres = Aabb::empty();
+        for (const Ref& ref : range) centres = centres.merged({ref.centre, ref.centre});
+        const std::uint32_t bins = std::clamp(options_.bin_count, 2u, 256u);
+        struct Bin {
+            Aabb box = Aabb::empty();
+            double count = 0;
+        };
+        std::vector<Bin> bin(3 * std::size_t{bins});
+        std::array<double, 3> scale{};
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+            const double extent = centres.max[static_cast<Eigen::Index>(axis)] - centres.min[static_cast<Eigen::Index>(axis)];
+            scale[axis] = extent > 0.0 ? static_cast<double>(bins) / extent : 0.0;
+        }
+        auto bin_index = [&](const Ref& ref, std::size_t axis) {
+            const auto a = static_cast<Eigen::Index>(axis);
+            const double at = (ref.centre[a] - centres.min[a]) * scale[axis];
+            return std::min(bins - 1, static_cast<std::uint32_t>(std::max(0.0, at)));
+        };
+        for (const Ref& ref : range)
+            for (std::size_t axis = 0; axis < 3; ++axis) {
+                if (scale[axis] == 0.0) continue;
+                Bin& b = bin[axis * bins + bin_index(ref, axis)];
+                b.box = b.box.merged(ref.box);
+                b.count += 1.0;
+            }
+        CutCost best;
+        std::size_t best_axis = 3;
+        std::uint32_t best_boundary = 0;
+        std::vector<Aabb> right_sides(bins);
+        std::vector<double> right_counts(bins);
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+            if (scale[axis] == 0.0) continue;
+            const Bin* b = bin.data() + axis * bins;
+            Aabb running = Aabb::empty();
+            double count = 0;
+            for (std::uint32_t i = bins; i-- > 0;) {
+                running = running.merged(b[i].box);
+                count += b[i].count;
+                right_sides[i] = running;
+                right_counts[i] = count;
+            }
+            running = Aabb::empty();
+            count = 0;
+            for (std::uint32_t boundary = 1; boundary < bins; ++boundary) {
+                running = running.merged(b[boundary - 1].box);
+                count += b[boundary - 1].count;
+                if (count == 0 || right_counts[boundary] == 0) continue;
+                const CutCost cost = cut_cost(count, running, right_counts[boundary], right_sides[boundary]);
+                if (cost < best) best = cost, best_axis = axis, best_boundary = boundary;
+            }
+        }
+        if (best_axis == 3) return 0;
+        // std::partition's result depends only on the range's contents and order, never on threads.
+        const auto middle = std::partition(range.begin(), range.end(),
+                                           [&](const Ref& ref) { return bin_index(ref, best_axis) < best_boundary; });
+        return static_cast<std::uint32_t>(middle - range.begin());
+    }
+
+    /// Cuts are priced by the sides' world boxes whatever kinds are allowed: pricing OBBs and capsules in the
+    /// range's principal frame as well (as split does) gave no cheaper trees in the end (the kept nodes' own
+    /// fits decide their kinds) and cost 15 % of the build at 10^6 primitives (docs/scale.md §9).
+    [[nodiscard]] static CutCost cut_cost(double left_count, const Aabb& left, double right_count, const Aabb& right) {
+        const double wl = side_weight(left_count), wr = side_weight(right_count);
+        return {wl * left.volume() + wr * right.volume(), wl * box_area(left) + wr * box_area(right)};
+    }
+
+    /// The median along the centres' longest extent (ties by local index): balanced whatever the input.
+    static std::uint32_t median_cut(std::span<Ref> range) {
+        Aabb centres = Aabb::empty();
+        for (const Ref& ref : range) centres = centres.merged({ref.centre, ref.centre});
+        int axis = 0;
+        (centres.max - centres.min).maxCoeff(&axis);
+        const auto middle = range.begin() + static_cast<std::ptrdiff_t>(range.size() / 2);
+        std::nth_element(range.begin(), middle, range.end(), [axis](const Ref& a, const Ref& b) {
+            return a.centre[axis] != b.centre[axis] ? a.centre[axis] < b.centre[axis] : a.local < b.local;
+        });
+        return static_cast<std::uint32_t>(range.size() / 2);
+    }
+
+    static void sort_along(std::span<Ref> range, int axis) {
+        std::sort(range.begin(), range.end(), [axis](const Ref& a, const Ref& b) {
+            return a.centre[axis] != b.centre[axis] ? a.centre[axis] < b.centre[axis] : a.local < b.local;
+        });
+    }
+
+    // ---- Step 2: the collapse --------------------------------------------------------------------------
+
+    // For each binary node v, best[k] (k = 1..max_children) is the least Eq. 2 cost below v's nearest kept
+    // ancestor A that v's subtree adds when it makes k of A's children: k = 1 keeps v (its own volume once per
+    // child it keeps, plus its subtree), k >= 2 dissolves v into k pieces from below it. What A pays for them,
+    // k x volume(A), is added where A is known. split[k] records the left child's share of k, and split[1]
+    // the number of children v keeps. A min-plus convolution per node, O(n x max_children^2) in all. The
+    // volume priced is the node's box, the one volume known for every binary node without a fit; the kept
+    // nodes are fitted afterwards (step 3), which only makes them smaller.
+    void collapse_costs(std::uint32_t slot) {
+        const BinaryNode& node = nodes_[slot];
+        const double* left = best_of(node.left);
+        const double* right = best_of(node.right);
+        double* best = best_of(slot);
+        std::uint8_t* split = split_of(slot);
+        const std::uint32_t m = max_children_;
+        for (std::uint32_t k = 2; k <= m; ++k)
+            for (std::uint32_t i = 1; i < k; ++i) {
+                const double cost = left[i] + right[k - i];
+                if (cost < best[k]) best[k] = cost, split[k] = static_cast<std::uint8_t>(i);
+            }
+        const double volume = box_weight_ * node.box.volume();
+        double kept = infinity;
+        std::uint8_t children = 2;
+        for (std::uint32_t k = 2; k <= m; ++k) {
+            const double cost = static_cast<double>(k) * volume + best[k];
+            if (cost < kept) kept = cost, children = static_cast<std::uint8_t>(k);
+        }
+        best[1] = kept;
+        split[1] = children;
+    }
+
+    /// Appends the slots of the `k` pieces of binary node `slot` (kept nodes or leaves), left to right.
+    void pieces(std::uint32_t slot, std::uint32_t k, std::vector<std::uint32_t>& out) {
+        if (k == 1) {
+            out.push_back(slot);
+            return;
+        }
+        const std::uint32_t left_share = split_of(slot)[k];
+        pieces(nodes_[slot].left, left_share, out);
+        pieces(nodes_[slot].right, k - left_share, out);
+    }
+
+    /// The kept nodes below and at `slot` (kept with `k` children), children before parents, with the
+    /// moments of each (when a frame is fitted).
+    void collect(std::uint32_t slot, std::uint32_t k, std::vector<WideNode>& wide) {
+        WideNode node;
+        node.slot = slot;
+        node.first_piece = static_cast<std::uint32_t>(pieces_.size());
+        pieces(nodes_[slot].left, split_of(slot)[k], pieces_);
+        pieces(nodes_[slot].right, k - split_of(slot)[k], pieces_);
+        node.piece_count = static_cast<std::uint32_t>(pieces_.size()) - node.first_piece;
+        Moments sum;
+        for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p) {
+            const std::uint32_t child = pieces_[p];
+            if (nodes_[child].is_leaf) {
+                if (needs_moments_) sum.add(refs_[nodes_[child].begin].spheres);
+                continue;
+            }
+            collect(child, split_of(child)[1], wide);
+            if (needs_moments_) sum.add(moments_.back());
+        }
+        wide.push_back(node);
+        if (needs_moments_) moments_.push_back(sum);
+    }
+
+    // ---- Step 3: one fit per kept node -----------------------------------------------------------------
+
+    /// Fits every kept node, children before parents (a node's hull fit uses its children's volumes), the
+    /// subtrees of large nodes in parallel. Each volume depends on its subtree only, so on no thread count.
+    void fit_all(std::vector<WideNode>& wide) {
+        std::vector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
+        for (std::uint32_t i = 0; i < wide.size(); ++i) wide_of_slot[wide[i].slot] = i;
+        std::atomic<std::uint64_t> fitted{0};
+        fit_subtree(static_cast<std::uint32_t>(wide.size() - 1), wide, wide_of_slot, fitted);
+    }
+
+    void fit_subtree(std::uint32_t index, std::vector<WideNode>& wide, const std::vector<std::uint32_t>& wide_of_slot,
+                     std::atomic<std::uint64_t>& fitted) {
+        WideNode& node = wide[index];
+        const BinaryNode& binary = nodes_[node.slot];
+        std::vector<std::uint32_t> inner;
+        for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p)
+            if (!nodes_[pieces_[p]].is_leaf) inner.push_back(wide_of_slot[pieces_[p]]);
+        constexpr std::uint32_t parallel_above = 4096;  // primitives below a node worth a task per child
+        if (binary.end - binary.begin > parallel_above)
+            tbb::parallel_for(std::size_t{0}, inner.size(), [&](std::size_t i) { fit_subtree(inner[i], wide, wide_of_slot, fitted); });
+        else
+            for (const std::uint32_t child : inner) fit_subtree(child, wide, wide_of_slot, fitted);
+        node.volume = fit_node(node, wide, wide_of_slot, needs_moments_ ? moments_[index] : Moments{});
+        const double n = static_cast<double>(refs_.size());
+        const auto done = static_cast<double>(fitted.fetch_add(1, std::memory_order_relaxed) + 1);
+        checkpoint_.step(n + n * done / static_cast<double>(wide.size()));
+    }
+
+    /// The smallest, by the policy's weights, of these enclosing volumes of the node's primitives:
+    /// - the exact box; the box and the capsule on the main axis in the principal frame of the sphere centres
+    ///   (from `moments`); the sphere around the box centre: one pass over the generating spheres;
+    /// - boxes in DiTO's frames of those spheres (detail::dito_frames: extremal points along fixed directions,
+    ///   no hull), where OBBs are allowed;
+    /// - for nodes over at least `hull_fit_min_primitives`, fit_obb (hull-based) around its children's
+    ///   volumes: it encloses them, so the primitives, and has a few dozen points however large the node is;
+    /// - fit_best over the primitives, for nodes of at most `exact_fit_max_primitives`.
+    BoundingVolume fit_node(const WideNode& wide_node, const std::vector<WideNode>& wide,
+                            const std::vector<std::uint32_t>& wide_of_slot, const Moments& moments) const {
+        const BinaryNode& node = nodes_[wide_node.slot];
+        const VolumePolicy& policy = set_.policy();
+        double best_volume = infinity;
+        BoundingVolume best = node.box;
+        auto consider = [&](BoundingVolume&& bv) {
+            if (!policy.is_allowed(type_of(bv))) return;
+            const double v = policy.weighted_volume(bv);
+            if (v < best_volume) best_volume = v, best = std::move(bv);
+        };
+        consider(BoundingVolume(node.box));
+        const bool want_obb = policy.is_allowed(BvType::obb);
+        const bool want_frame = needs_moments_;
+        const bool want_sphere = policy.is_allowed(BvType::sphere);
+        const std::span<const Ref> range(refs_.data() + node.begin, node.end - node.begin);
+        if (want_frame || want_sphere) {
+            const Vec3 origin = want_frame ? Vec3(moments.sum / moments.count) : node.box.center();
+            const Mat3 axes =
+                want_frame ? principal_axes(moments.outer / moments.count - origin * origin.transpose()) : Mat3::Identity();
+            const Vec3 centre = node.box.center();
+            Vec3 low = Vec3::Constant(infinity), high = Vec3::Constant(-infinity);
+            double sphere_radius = 0.0, capsule_radius = 0.0, t_low = infinity, t_high = -infinity;
+            for (const Ref& ref : range)
+                for (const Sphere& s : ref.spheres) {
+                    if (want_sphere) sphere_radius = std::max(sphere_radius, (s.center - centre).norm() + s.radius);
+                    if (!want_frame) continue;
+                    const Vec3 local = axes.transpose() * (s.center - origin);
+                    low = low.cwiseMin(local - Vec3::Constant(s.radius));
+                    high = high.cwiseMax(local + Vec3::Constant(s.radius));
+                    capsule_radius = std::max(capsule_radius, std::sqrt(local.y() * local.y() + local.z() * local.z()) + s.radius);
+                    t_low = std::min(t_low, local.x());
+                    t_high = std::max(t_high, local.x());
+                }
+            if (want_sphere) consider(Sphere{centre, sphere_radius});
+            if (want_frame) {
+                consider(Obb{origin + axes * (0.5 * (low + high)), axes, 0.5 * (high - low)});
+                const Vec3 u = axes.col(0);
+                consider(Capsule{origin + t_low * u, origin + t_high * u, capsule_radius});
+            }
+        }
+        const std::size_t size = range.size();
+        if (want_obb && size <= options_.hull_fit_max_primitives) {
+            thread_local std::vector<Sphere> spheres;
+            spheres.clear();
+            for (const Ref& ref : range) spheres.insert(spheres.end(), ref.spheres.begin(), ref.spheres.end());
+            for (const Mat3& frame : detail::dito_frames(spheres)) consider(detail::obb_with_axes(spheres, frame));
+            if (size >= options_.hull_fit_min_primitives && refs_.size() <= options_.hull_fit_max_input)
+                consider(fit(BvType::obb, spheres));
+        } else if (want_obb) {
+            {
+                std::vector<Sphere> around;
+                for (std::uint32_t p = wide_node.first_piece; p < wide_node.first_piece + wide_node.piece_count; ++p) {
+                    const BinaryNode& child = nodes_[pieces_[p]];
+                    append_generating_spheres(child.is_leaf ? set_.volume_of(refs_[child.begin].local)
+                                                            : wide[wide_of_slot[pieces_[p]]].volume,
+                                              around);
+                }
+                consider(fit(BvType::obb, around));
+            }
+        }
+        if (range.size() <= options_.exact_fit_max_primitives) {
+            std::vector<std::uint32_t> locals;
+            for (const Ref& ref : range) locals.push_back(ref.local);
+            consider(set_.fit(locals));
+        }
+        return best;
+    }
+
+    // ---- Step 4: the hierarchy -------------------------------------------------------------------------
+
+    /// `wide` (children before parents, the root last) as `bvh.nodes`, breadth-first (a node's children are
+    /// appended together, so they are contiguous). Leaves carry their primitive's own volume.
+    void lay_out(std::vector<WideNode>& wide, Bvh& bvh) const {
+        std::vector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
+        for (std::uint32_t i = 0; i < wide.size(); ++i) wide_of_slot[wide[i].slot] = i;
+        bvh.nodes.reserve(wide.size() + refs_.size());
+        std::vector<std::uint32_t> queue{static_cast<std::uint32_t>(wide.size() - 1)}, node_of(1, 0);
+        bvh.nodes.push_back(Node{std::move(wide.back().volume), 0, 0, 0});
+        for (std::size_t q = 0; q < queue.size(); ++q) {
+            const WideNode& node = wide[queue[q]];
+            bvh.nodes[node_of[q]].first_child = static_cast<std::uint32_t>(bvh.nodes.size());
+            bvh.nodes[node_of[q]].child_count = node.piece_count;
+            for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p) {
+                const BinaryNode& child = nodes_[pieces_[p]];
+                if (child.is_leaf) {
+                    const std::uint32_t primitive = set_.input_index(refs_[child.begin].local);
+                    bvh.nodes.push_back(Node{bvh.primitives[primitive].volume, 0, 0, primitive});
+                    continue;
+                }
+                const std::uint32_t index = wide_of_slot[pieces_[p]];
+                queue.push_back(index);
+                node_of.push_back(static_cast<std::uint32_t>(bvh.nodes.size()));
+                bvh.nodes.push_back(Node{std::move(wide[index].volume), 0, 0, 0});
+            }
+        }
+    }
+
+    const PrimitiveSet& set_;
+    const BinnedOptions& options_;
+    const detail::Checkpoint& checkpoint_;
+    std::uint32_t max_children_;
+    std::uint32_t depth_limit_ = 0;
+    double box_weight_ = 1.0;
+    bool needs_moments_ = false;               ///< Whether OBBs or capsules are fitted (they need a frame).
+    std::vector<std::uint32_t> pieces_;        ///< The kept nodes' children, as slots, node after node.
+    std::vector<Moments> moments_;             ///< Per kept node (as `wide`), when needs_moments_.
+    std::atomic<std::uint64_t> placed_{0};  ///< Leaves made so far, for progress (any thread).
+    std::vector<Ref> refs_;                 ///< The primitives; each plan() reorders only its range.
+    std::vector<BinaryNode> nodes_;         ///< n leaves, then n - 1 inner nodes by their cut position.
+    std::vector<double> best_;              ///< (max_children + 1) collapse costs per node.
+    std::vector<std::uint8_t> split_;       ///< (max_children + 1) collapse choices per node.
+};
+
+}  // namespace
+}  // namespace binned_internal
+
+Result<Bvh> build_binned(std::span<const Primitive> primitives, const BuildContext& context, const BinnedOptions& options) {
+    return detail::guarded_build(primitives, context, "binned", 2.0 * static_cast<double>(primitives.size()),
+                                 [&](const detail::Checkpoint& checkpoint) {
+                                     std::vector<std::uint32_t> order(primitives.size());
+                                     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+                                     const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
+                                     return binned_internal::BinnedBuilder(set, options, checkpoint).build(primitives);
+                                 });
+}
+
+}  // namespace hbvh
