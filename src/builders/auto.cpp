@@ -98,11 +98,11 @@ std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
     if (primitive_count <= auto_optimal_max_primitives) return {Algorithm::optimal};
     if (primitive_count <= auto_exact_max_primitives)
         return {Algorithm::bnb_exact, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split,
-                Algorithm::merge, Algorithm::scale};
+                Algorithm::merge, Algorithm::scale, Algorithm::binned};
     if (primitive_count <= auto_insertion_max_primitives)
-        return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split};
-    if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::scale, Algorithm::split};
-    return {Algorithm::scale};
+        return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::binned};
+    if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::binned, Algorithm::split};
+    return {Algorithm::binned};
 }
 
 }  // namespace hbvh

@@ -18,6 +18,7 @@
 #include "guarded_build.hpp"
 #include "heuristic_support.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "hbvh/tree/stats.hpp"
 #include "../fit/frames.hpp"
 
 namespace hbvh {
@@ -27,6 +28,8 @@ namespace {
 using detail::PrimitiveSet;
 
 constexpr std::uint32_t max_children_limit = 16;
+/// Ranges up to this size are swept with per-side fits (estimate_sweep_cut) in small inputs, as split does.
+constexpr std::size_t estimate_sweep_max_primitives = 64;
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
 double box_area(const Aabb& box) {
@@ -113,8 +116,12 @@ Mat3 principal_axes(const Mat3& covariance) {
 
 class BinnedBuilder {
 public:
-    BinnedBuilder(const PrimitiveSet& set, const BinnedOptions& options, const detail::Checkpoint& checkpoint)
-        : set_(set), options_(options), checkpoint_(checkpoint),
+    /// `count_weighted_estimates`: the per-side sweeps of small inputs weight each side by its primitive count
+    /// instead of side_weight (build_binned tries both there); `progress_offset`: added to every progress step.
+    BinnedBuilder(const PrimitiveSet& set, const BinnedOptions& options, const detail::Checkpoint& checkpoint,
+                  bool count_weighted_estimates, double progress_offset)
+        : set_(set), options_(options), checkpoint_(checkpoint), count_weighted_estimates_(count_weighted_estimates),
+          progress_offset_(progress_offset),
           max_children_(std::clamp(options.max_children, 2u, max_children_limit)), refs_(set.size()),
           nodes_(2 * std::size_t{set.size()} - 1), best_(nodes_.size() * (max_children_ + 1), infinity),
           split_(nodes_.size() * (max_children_ + 1), 0) {
@@ -166,7 +173,7 @@ private:
             placed_.fetch_add(1, std::memory_order_relaxed);
             return begin;
         }
-        checkpoint_.step(static_cast<double>(placed_.load(std::memory_order_relaxed)));
+        checkpoint_.step(progress_offset_ + static_cast<double>(placed_.load(std::memory_order_relaxed)));
         const std::uint32_t cut = begin + choose_cut(std::span(refs_.data() + begin, end - begin), depth);
         std::uint32_t left = 0, right = 0;
         constexpr std::uint32_t parallel_above = 4096;  // below, a task costs more than the range
@@ -183,6 +190,8 @@ private:
     /// Reorders `range` so that the cut falls before the returned position (0 < cut < size).
     std::uint32_t choose_cut(std::span<Ref> range, std::uint32_t depth) const {
         if (depth >= depth_limit_) return median_cut(range);
+        if (refs_.size() <= options_.estimate_sweep_up_to && range.size() <= estimate_sweep_max_primitives)
+            return estimate_sweep_cut(range);
         if (range.size() <= options_.sweep_max_primitives) return sweep_cut(range);
         if (const std::uint32_t cut = binned_cut(range); cut != 0) return cut;
         return median_cut(range);
@@ -203,6 +212,33 @@ private:
             for (std::size_t left = 1; left < count; ++left) {
                 running = running.merged(range[left - 1].box);
                 const CutCost cost = cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides[left]);
+                if (cost < best) best = cost, best_axis = axis, best_cut = left;  // ties: the earlier axis and cut
+            }
+        }
+        if (best_axis != 2) sort_along(range, best_axis);
+        return static_cast<std::uint32_t>(best_cut);
+    }
+
+    [[nodiscard]] double estimate_weight(double count) const { return count_weighted_estimates_ ? count : side_weight(count); }
+
+    /// As sweep_cut, but each side priced as split prices its small nodes: the pricing fitter around that side
+    /// alone (detail::PrimitiveSet::estimate: exact AABB and sphere, OBBs and capsules in the side's own
+    /// frames), so a cut is chosen for the kinds the sides will have. O(m^2) fits per range: small inputs only.
+    std::uint32_t estimate_sweep_cut(std::span<Ref> range) const {
+        const std::size_t count = range.size();
+        std::vector<std::uint32_t> locals(count);
+        std::vector<double> right_sides(count);
+        CutCost best;
+        int best_axis = 0;
+        std::size_t best_cut = count / 2;
+        for (int axis = 0; axis < 3; ++axis) {
+            sort_along(range, axis);
+            for (std::size_t i = 0; i < count; ++i) locals[i] = range[i].local;
+            const std::span<const std::uint32_t> all(locals);
+            for (std::size_t i = 1; i < count; ++i) right_sides[i] = set_.estimate(all.subspan(i));
+            for (std::size_t left = 1; left < count; ++left) {
+                const double wl = estimate_weight(static_cast<double>(left)), wr = estimate_weight(static_cast<double>(count - left));
+                const CutCost cost{wl * set_.estimate(all.first(left)) + wr * right_sides[left], 0.0};
                 if (cost < best) best = cost, best_axis = axis, best_cut = left;  // ties: the earlier axis and cut
             }
         }
@@ -390,7 +426,7 @@ private:
         node.volume = fit_node(node, wide, wide_of_slot, needs_moments_ ? moments_[index] : Moments{});
         const double n = static_cast<double>(refs_.size());
         const auto done = static_cast<double>(fitted.fetch_add(1, std::memory_order_relaxed) + 1);
-        checkpoint_.step(n + n * done / static_cast<double>(wide.size()));
+        checkpoint_.step(progress_offset_ + n + n * done / static_cast<double>(wide.size()));
     }
 
     /// The smallest, by the policy's weights, of these enclosing volumes of the node's primitives:
@@ -443,26 +479,28 @@ private:
             }
         }
         const std::size_t size = range.size();
-        if (want_obb && size <= options_.hull_fit_max_primitives) {
+        const std::size_t dito_max = options_.dito_fit_max_primitives;
+        const bool hull_over_spheres = size >= options_.hull_fit_min_primitives && size <= options_.hull_fit_max_primitives &&
+                                       refs_.size() <= options_.hull_fit_max_input;
+        if (want_obb && (size <= dito_max || hull_over_spheres)) {
             thread_local std::vector<Sphere> spheres;
             spheres.clear();
             for (const Ref& ref : range) spheres.insert(spheres.end(), ref.spheres.begin(), ref.spheres.end());
-            for (const Mat3& frame : detail::dito_frames(spheres)) consider(detail::obb_with_axes(spheres, frame));
-            if (size >= options_.hull_fit_min_primitives && refs_.size() <= options_.hull_fit_max_input)
-                consider(fit(BvType::obb, spheres));
-        } else if (want_obb) {
-            {
-                std::vector<Sphere> around;
-                for (std::uint32_t p = wide_node.first_piece; p < wide_node.first_piece + wide_node.piece_count; ++p) {
-                    const BinaryNode& child = nodes_[pieces_[p]];
-                    append_generating_spheres(child.is_leaf ? set_.volume_of(refs_[child.begin].local)
-                                                            : wide[wide_of_slot[pieces_[p]]].volume,
-                                              around);
-                }
-                consider(fit(BvType::obb, around));
-            }
+            if (size <= dito_max)
+                for (const Mat3& frame : detail::dito_frames(spheres)) consider(detail::obb_with_axes(spheres, frame));
+            if (hull_over_spheres) consider(fit(BvType::obb, spheres));
         }
-        if (range.size() <= options_.exact_fit_max_primitives) {
+        if (want_obb && !hull_over_spheres && size >= options_.hull_fit_min_primitives) {
+            std::vector<Sphere> around;
+            for (std::uint32_t p = wide_node.first_piece; p < wide_node.first_piece + wide_node.piece_count; ++p) {
+                const BinaryNode& child = nodes_[pieces_[p]];
+                append_generating_spheres(child.is_leaf ? set_.volume_of(refs_[child.begin].local)
+                                                        : wide[wide_of_slot[pieces_[p]]].volume,
+                                          around);
+            }
+            consider(fit(BvType::obb, around));
+        }
+        if (range.size() <= options_.exact_fit_max_primitives || refs_.size() <= options_.exact_fit_all_up_to) {
             std::vector<std::uint32_t> locals;
             for (const Ref& ref : range) locals.push_back(ref.local);
             consider(set_.fit(locals));
@@ -502,6 +540,8 @@ private:
     const PrimitiveSet& set_;
     const BinnedOptions& options_;
     const detail::Checkpoint& checkpoint_;
+    bool count_weighted_estimates_;
+    double progress_offset_;
     std::uint32_t max_children_;
     std::uint32_t depth_limit_ = 0;
     double box_weight_ = 1.0;
@@ -519,13 +559,22 @@ private:
 }  // namespace binned_internal
 
 Result<Bvh> build_binned(std::span<const Primitive> primitives, const BuildContext& context, const BinnedOptions& options) {
-    return detail::guarded_build(primitives, context, "binned", 2.0 * static_cast<double>(primitives.size()),
-                                 [&](const detail::Checkpoint& checkpoint) {
-                                     std::vector<std::uint32_t> order(primitives.size());
-                                     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-                                     const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
-                                     return binned_internal::BinnedBuilder(set, options, checkpoint).build(primitives);
-                                 });
+    const auto n = static_cast<double>(primitives.size());
+    // Small inputs are built twice, their per-side sweeps weighting sides by log2 of their counts and by the
+    // counts themselves, and keep the cheaper tree: on the 20 bundled and ../shared/data models neither
+    // weighting is the better on all of them (docs/scale.md §9), and each build takes milliseconds there.
+    const bool twice = primitives.size() <= options.estimate_sweep_up_to;
+    return detail::guarded_build(primitives, context, "binned", (twice ? 4.0 : 2.0) * n, [&](const detail::Checkpoint& checkpoint) {
+        std::vector<std::uint32_t> order(primitives.size());
+        for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+        const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
+        Bvh tree = binned_internal::BinnedBuilder(set, options, checkpoint, false, 0.0).build(primitives);
+        if (twice) {
+            Bvh other = binned_internal::BinnedBuilder(set, options, checkpoint, true, 2.0 * n).build(primitives);
+            if (cost(other, context.policy) < cost(tree, context.policy)) tree = std::move(other);
+        }
+        return tree;
+    });
 }
 
 }  // namespace hbvh

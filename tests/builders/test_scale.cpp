@@ -126,7 +126,7 @@ TEST(Auto, PicksBySizeAndSaysSo) {
 // report says so. The first member always runs, so there is a valid tree.
 TEST(Auto, TimeLimitSkipsTheRestOfThePortfolio) {
     const std::vector<Primitive> primitives = generated_scene(auto_insertion_max_primitives + 50, 17);
-    ASSERT_EQ(auto_portfolio(primitives.size()), (std::vector<Algorithm>{Algorithm::scale, Algorithm::split}));
+    ASSERT_EQ(auto_portfolio(primitives.size()), (std::vector<Algorithm>{Algorithm::binned, Algorithm::split}));
     BuildReport report;
     const BuildContext options = test_support::context_for(VolumePolicy::all(), &report).with_time_limit(1e-6);
     Result<Bvh> built = build(primitives, Algorithm::automatic, options);

@@ -17,18 +17,19 @@ namespace hbvh {
 
 /// Input sizes at which `auto` changes strategy (auto_portfolio). Up to auto_optimal_max_primitives: the
 /// optimal subset DP alone (~1 s at 10 primitives, doubling per primitive). Up to
-/// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge and scale
-/// (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
+/// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge, scale and
+/// binned (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
 /// none wins everywhere, docs/results.md §1). Up to auto_insertion_max_primitives: the cheapest of scale,
-/// insertion-haber, insertion and split; up to auto_portfolio_max_primitives: of scale and split (at 1000
-/// primitives the insertions took 5-7 s, split 0.2 s, scale 0.15 s; at 20 000 split 3.4 s and 1.6x cheaper
-/// than scale, 1.3 s). Above: scale alone (docs/scale.md §5).
+/// insertion-haber, insertion, split and binned; up to auto_portfolio_max_primitives: of binned and split (at
+/// 1000 primitives the insertions took 5-7 s, split 0.2 s, binned 0.3 s, and either may be the cheaper).
+/// Above: binned alone, 0.2 s and 0.2 % cheaper than split at 20 000 primitives, where split takes 3 s
+/// (docs/scale.md §9).
 /// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
 /// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
 inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
 inline constexpr std::uint32_t auto_exact_max_primitives = 24;
 inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
-inline constexpr std::uint32_t auto_portfolio_max_primitives = 20'000;
+inline constexpr std::uint32_t auto_portfolio_max_primitives = 2'000;
 inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
 inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 

@@ -19,22 +19,29 @@ struct BinnedOptions {
     std::uint32_t bin_count = 32;
     /// Ranges of at most this many primitives try every cut of their centres sorted along x, y and z.
     std::uint32_t sweep_max_primitives = 16;
+    /// In inputs of at most this many primitives, ranges of at most 64 are swept with each side priced by
+    /// the pricing fitter around it (as split prices its small nodes) instead of by its box.
+    std::uint32_t estimate_sweep_up_to = 2000;
     /// The most children a node of the result may have (2..16). The collapse keeps a binary node only where
     /// that lowers Eq. 2; this bounds how many it may merge into one.
     std::uint32_t max_children = 8;
-    /// Where OBBs are allowed, kept nodes over at most `hull_fit_max_primitives` primitives try boxes in the
-    /// DiTO frames of their generating spheres, and from `hull_fit_min_primitives` on fit_obb (hull-based)
-    /// over those spheres too; larger nodes fit_obb around their children's volumes (a few dozen points
-    /// however large the node). Every node also has the cheap fits: exact AABB; OBB and capsule in the
-    /// principal frame of its sphere centres; the sphere around its box centre.
+    /// Where OBBs are allowed, every kept node tries the box in the principal frame of its sphere centres; those
+    /// over at most `dito_fit_max_primitives` also the boxes in DiTO's frames of their spheres (extremal points
+    /// along 13 directions, no hull); those between `hull_fit_min_primitives` and `hull_fit_max_primitives`
+    /// fit_obb (hull-based) over their spheres, in inputs of at most `hull_fit_max_input` primitives (it costs
+    /// about 0.6 µs a sphere, and at 10^6 primitives that band holds 2.5·10^7 spheres); every other node from
+    /// `hull_fit_min_primitives` on fit_obb around its children's volumes (a few dozen points however large the
+    /// node). Every node also has the exact AABB, the capsule on its main axis and the sphere around its box
+    /// centre, where allowed.
+    std::uint32_t dito_fit_max_primitives = 16;
     std::uint32_t hull_fit_min_primitives = 128;
     std::uint32_t hull_fit_max_primitives = 4096;
-    /// ... but fit_obb over the spheres only for inputs of at most this many primitives: it costs about 0.6 µs
-    /// a sphere (qhull), and at 10^6 primitives the nodes between the two limits hold 2.5·10^7 spheres.
     std::uint32_t hull_fit_max_input = 200'000;
     /// Kept nodes over at most this many primitives also try fit_best (every fitter of fit/fit.hpp) over
     /// their primitives. 0: none (fit_best costs about 0.1 ms a call, the rest of a node's fit a microsecond).
     std::uint32_t exact_fit_max_primitives = 0;
+    /// Inputs of at most this many primitives have every kept node refitted with fit_best as well.
+    std::uint32_t exact_fit_all_up_to = 1000;
 };
 
 /// A hierarchy for large scenes (10^4 to 10^6 primitives and more), in O(n log n) and on every core:
