@@ -453,6 +453,29 @@ private:
         const bool want_frame = needs_moments_;
         const bool want_sphere = policy.is_allowed(BvType::sphere);
         const std::span<const Ref> range(refs_.data() + node.begin, node.end - node.begin);
+        const std::size_t size = range.size();
+        const bool hull_over_spheres = size >= options_.hull_fit_min_primitives && size <= options_.hull_fit_max_primitives &&
+                                       refs_.size() <= options_.hull_fit_max_input;
+        // A large node's children's volumes stand for its primitives: they enclose them, and their generating
+        // spheres are a few dozen however many primitives lie below (the pass over all of them was a quarter
+        // of the build at 10^6 primitives).
+        const bool around_children = size >= options_.hull_fit_min_primitives && !hull_over_spheres;
+        std::vector<Sphere> around;
+        if (around_children)
+            for (std::uint32_t p = wide_node.first_piece; p < wide_node.first_piece + wide_node.piece_count; ++p) {
+                const BinaryNode& child = nodes_[pieces_[p]];
+                append_generating_spheres(child.is_leaf ? set_.volume_of(refs_[child.begin].local)
+                                                        : wide[wide_of_slot[pieces_[p]]].volume,
+                                          around);
+            }
+        auto for_each_sphere = [&](auto&& visit) {
+            if (around_children) {
+                for (const Sphere& s : around) visit(s);
+                return;
+            }
+            for (const Ref& ref : range)
+                for (const Sphere& s : ref.spheres) visit(s);
+        };
         if (want_frame || want_sphere) {
             const Vec3 origin = want_frame ? Vec3(moments.sum / moments.count) : node.box.center();
             const Mat3 axes =
@@ -460,17 +483,16 @@ private:
             const Vec3 centre = node.box.center();
             Vec3 low = Vec3::Constant(infinity), high = Vec3::Constant(-infinity);
             double sphere_radius = 0.0, capsule_radius = 0.0, t_low = infinity, t_high = -infinity;
-            for (const Ref& ref : range)
-                for (const Sphere& s : ref.spheres) {
-                    if (want_sphere) sphere_radius = std::max(sphere_radius, (s.center - centre).norm() + s.radius);
-                    if (!want_frame) continue;
-                    const Vec3 local = axes.transpose() * (s.center - origin);
-                    low = low.cwiseMin(local - Vec3::Constant(s.radius));
-                    high = high.cwiseMax(local + Vec3::Constant(s.radius));
-                    capsule_radius = std::max(capsule_radius, std::sqrt(local.y() * local.y() + local.z() * local.z()) + s.radius);
-                    t_low = std::min(t_low, local.x());
-                    t_high = std::max(t_high, local.x());
-                }
+            for_each_sphere([&](const Sphere& s) {
+                if (want_sphere) sphere_radius = std::max(sphere_radius, (s.center - centre).norm() + s.radius);
+                if (!want_frame) return;
+                const Vec3 local = axes.transpose() * (s.center - origin);
+                low = low.cwiseMin(local - Vec3::Constant(s.radius));
+                high = high.cwiseMax(local + Vec3::Constant(s.radius));
+                capsule_radius = std::max(capsule_radius, std::sqrt(local.y() * local.y() + local.z() * local.z()) + s.radius);
+                t_low = std::min(t_low, local.x());
+                t_high = std::max(t_high, local.x());
+            });
             if (want_sphere) consider(Sphere{centre, sphere_radius});
             if (want_frame) {
                 consider(Obb{origin + axes * (0.5 * (low + high)), axes, 0.5 * (high - low)});
@@ -478,10 +500,7 @@ private:
                 consider(Capsule{origin + t_low * u, origin + t_high * u, capsule_radius});
             }
         }
-        const std::size_t size = range.size();
         const std::size_t dito_max = options_.dito_fit_max_primitives;
-        const bool hull_over_spheres = size >= options_.hull_fit_min_primitives && size <= options_.hull_fit_max_primitives &&
-                                       refs_.size() <= options_.hull_fit_max_input;
         if (want_obb && (size <= dito_max || hull_over_spheres)) {
             thread_local std::vector<Sphere> spheres;
             spheres.clear();
@@ -490,16 +509,7 @@ private:
                 for (const Mat3& frame : detail::dito_frames(spheres)) consider(detail::obb_with_axes(spheres, frame));
             if (hull_over_spheres) consider(fit(BvType::obb, spheres));
         }
-        if (want_obb && !hull_over_spheres && size >= options_.hull_fit_min_primitives) {
-            std::vector<Sphere> around;
-            for (std::uint32_t p = wide_node.first_piece; p < wide_node.first_piece + wide_node.piece_count; ++p) {
-                const BinaryNode& child = nodes_[pieces_[p]];
-                append_generating_spheres(child.is_leaf ? set_.volume_of(refs_[child.begin].local)
-                                                        : wide[wide_of_slot[pieces_[p]]].volume,
-                                          around);
-            }
-            consider(fit(BvType::obb, around));
-        }
+        if (want_obb && around_children) consider(fit(BvType::obb, around));
         if (range.size() <= options_.exact_fit_max_primitives || refs_.size() <= options_.exact_fit_all_up_to) {
             std::vector<std::uint32_t> locals;
             for (const Ref& ref : range) locals.push_back(ref.local);
