@@ -265,7 +265,8 @@ private:
         auto bin_index = [&](const Ref& ref, std::size_t axis) {
             const auto a = static_cast<Eigen::Index>(axis);
             const double at = (ref.centre[a] - centres.min[a]) * scale[axis];
-            return std::min(bins - 1, static_cast<std::uint32_t>(std::max(0.0, at)));
+            if (!(at > 0.0)) return 0u;  // NaN too: 0 x inf, a centre at the minimum of a denormal extent
+            return static_cast<std::uint32_t>(std::min(at, static_cast<double>(bins - 1)));
         };
         for (const Ref& ref : range)
             for (std::size_t axis = 0; axis < 3; ++axis) {
