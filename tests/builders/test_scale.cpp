@@ -23,8 +23,11 @@ using test_support::expect_identical_trees;
 using test_support::expect_tree_properties;
 using test_support::generated_scene;
 
+// Sizes around scale's thresholds (exact fits for all groups up to 64 primitives, refits on levels of at most
+// 256 nodes), up to 1000 (nine levels, the first two above 256 nodes). A 5000 scene (clustered only) took the
+// same paths again over three more levels, for about two thirds of the test's 15 s under the sanitizers.
 TEST(Scale, PropertiesOnGeneratedScenes) {
-    for (std::uint32_t count : {1u, 2u, 3u, 4u, 5u, 7u, 33u, 100u, 257u, 1000u, 5000u}) {
+    for (std::uint32_t count : {1u, 2u, 3u, 4u, 5u, 7u, 33u, 100u, 257u, 1000u}) {
         for (bool clustered : {true, false}) {
             SCOPED_TRACE(std::to_string(count) + (clustered ? " clustered" : " uniform"));
             const std::vector<Primitive> primitives = generated_scene(count, 100 + count, clustered);
@@ -34,7 +37,6 @@ TEST(Scale, PropertiesOnGeneratedScenes) {
             if (count > 1) {
                 EXPECT_FALSE(report.levels.empty());
             }
-            if (count > 1000) break;  // one 5000 scene is enough for the time budget
         }
     }
 }
@@ -53,8 +55,10 @@ TEST(Scale, PropertiesWithRestrictedPolicies) {
     }
 }
 
+// Each level's windows (about 32 nodes each) are solved in parallel: 1000 primitives give about 31 windows on
+// the first level, about a dozen on the second, ... (3000 took three times as long for more of the same).
 TEST(Scale, SameHierarchyForOneAndTwoThreads) {
-    const std::vector<Primitive> primitives = generated_scene(3000, 42);
+    const std::vector<Primitive> primitives = generated_scene(1000, 42);
     const auto build_with = [&](std::size_t threads) {
         const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
         return build_scale(primitives, test_support::context_for(VolumePolicy::all())).value();
@@ -63,9 +67,11 @@ TEST(Scale, SameHierarchyForOneAndTwoThreads) {
 }
 
 // merge is beaten on every scene. split is not: its top-down cuts give 30-40 % lower Eq. 2 costs than
-// scale's local bottom-up windows (docs/scale.md §4), so the ratio is recorded, not asserted.
+// scale's local bottom-up windows (docs/scale.md §4), so the ratio is recorded, not asserted. One scene: a
+// second one (1500 primitives, seed 6) checked the same again and doubled the time (28 s under the
+// sanitizers, half of it split's build for the recorded ratio).
 TEST(Scale, NoWorseThanMergeAndRatioToSplitRecorded) {
-    for (const auto& [count, seed] : {std::pair{1000u, 5u}, std::pair{1500u, 6u}}) {
+    for (const auto& [count, seed] : {std::pair{1000u, 5u}}) {
         SCOPED_TRACE(std::to_string(count));
         const std::vector<Primitive> primitives = generated_scene(count, seed);
         const double scale_cost = cost(build_scale(primitives, test_support::context_for(VolumePolicy::all())).value());

@@ -5,15 +5,7 @@ import pytest
 
 import brute_force
 import hbvh
-from conftest import MODELS, generated_set, random_poses, round_set
-
-
-def model(name):
-    if name == "generated":
-        return hbvh.Primitives(generated_set())
-    if name == "round":
-        return round_set()
-    return hbvh.load(str(MODELS / name))
+from conftest import built, model, random_poses
 
 
 def extent(primitives):
@@ -27,7 +19,7 @@ def extent(primitives):
 def test_pairs_equal_brute_force(name, algorithm):
     primitives = model(name)
     assert isinstance(primitives, hbvh.Primitives)
-    tree = hbvh.build(primitives, algorithm=algorithm)
+    tree = built(name, algorithm)
     assert len(tree.primitives) == len(primitives)
     rng = np.random.default_rng(len(name) * 31 + len(algorithm))
     reach = extent(primitives)
@@ -56,9 +48,9 @@ def test_pairs_equal_brute_force(name, algorithm):
 
 @pytest.mark.parametrize("name", ["chair.xml", "generated"])
 def test_two_different_models(name):
-    a = hbvh.build(model(name))
+    a = built(name)
     b_primitives = model("round")
-    b = hbvh.build(b_primitives, algorithm="merge")
+    b = built("round", "merge")
     rng = np.random.default_rng(3)
     for pose_b in random_poses(rng, 10, 2.0):
         pairs = {tuple(p) for p in hbvh.collide(a, None, b, pose_b)}
@@ -69,8 +61,8 @@ def test_two_different_models(name):
 @pytest.mark.parametrize("name", ["tie_interceptor.xml", "generated"])
 def test_collide_many_equals_repeated_collide(name):
     primitives = model(name)
-    a = hbvh.build(primitives)
-    b = hbvh.build(primitives, algorithm="insertion")
+    a = built(name)
+    b = built(name, "insertion")
     poses = random_poses(np.random.default_rng(5), 50, extent(primitives))
     many = hbvh.collide_many(a, b, poses)
     assert isinstance(many, list) and len(many) == len(poses)

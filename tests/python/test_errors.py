@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import hbvh
-from conftest import MODELS, run_cli
+from conftest import MODELS, built, run_cli
 
 
 def cli_message(cli, *args):
@@ -80,7 +80,7 @@ def test_malformed_files_match_the_cli(cli, tmp_path, content):
 
 def test_damaged_binary_and_missing_files_match_the_cli(cli, tmp_path):
     path = tmp_path / "chair.hbvh"
-    hbvh.build(hbvh.load(str(MODELS / "chair.xml"))).save(str(path))
+    built("chair.xml").save(str(path))
     data = path.read_bytes()
     path.write_bytes(data[:-20])  # truncated
     assert message_of(hbvh.load, str(path)) == cli_message(cli, "stats", path)
