@@ -64,7 +64,7 @@ def model(name):
 
 def built(name, algorithm="auto", types=None):
     """hbvh.build(model(name), ...), built once per session: several tests query the same tree (read only), and
-    the builds dominate the suite's time under the sanitizers (auto over the 80 generated primitives ~13 s,
+    the builds dominate the suite's time under the sanitizers (auto over the 80 generated primitives 10-13 s,
     bnb-exact over the tie interceptor ~7 s). Builds are deterministic, so a rebuild would be the same tree."""
     return _built(name, algorithm, types)
 
