@@ -33,6 +33,7 @@
 
 // The builders: build.hpp (build(), Algorithm) and the registry first, then one header per builder.
 #include <hbvh/builders/auto.hpp>
+#include <hbvh/builders/binned.hpp>
 #include <hbvh/builders/bnb_enlarge.hpp>
 #include <hbvh/builders/bnb_exact.hpp>
 #include <hbvh/builders/bnb_tightest.hpp>
