@@ -52,6 +52,14 @@ int write_all(int fd, std::string_view data) {
     return 0;
 }
 
+/// One read(), resumed after signals: the byte count, 0 at the end of the file, or -1 with errno set.
+ssize_t read_some(int fd, char* data, std::size_t size) {
+    for (;;) {
+        const ssize_t count = ::read(fd, data, size);
+        if (count >= 0 || errno != EINTR) return count;
+    }
+}
+
 /// A name for the temporary file that no other writer (thread or process) picks at the same time.
 /// Hidden (leading dot) so directory listings and globs don't catch a half-written file.
 std::filesystem::path temporary_name(const std::filesystem::path& target, unsigned attempt) {
@@ -78,14 +86,23 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
     struct stat info {};
     if (::fstat(file.get(), &info) == 0 && S_ISDIR(info.st_mode)) return Error("is a directory, not a file", name);
 
+    // A regular file is read straight into a string of its size: growing a string chunk by chunk would copy
+    // a large file several times over.
     std::string content;
+    if (S_ISREG(info.st_mode) && info.st_size > 0) content.resize(static_cast<std::size_t>(info.st_size));
+    std::size_t filled = 0;
+    while (filled < content.size()) {
+        const ssize_t count = read_some(file.get(), content.data() + filled, content.size() - filled);
+        if (count < 0) return Error("cannot read: " + describe(errno), name);
+        if (count == 0) break;  // the file shrank meanwhile
+        filled += static_cast<std::size_t>(count);
+    }
+    content.resize(filled);
+    // Then on to the end: the file may have grown, and pipes and /proc files report no size.
     char chunk[65536];
     for (;;) {
-        const ssize_t count = ::read(file.get(), chunk, sizeof chunk);
-        if (count < 0) {
-            if (errno == EINTR) continue;
-            return Error("cannot read: " + describe(errno), name);
-        }
+        const ssize_t count = read_some(file.get(), chunk, sizeof chunk);
+        if (count < 0) return Error("cannot read: " + describe(errno), name);
         if (count == 0) break;
         content.append(chunk, static_cast<std::size_t>(count));
     }
