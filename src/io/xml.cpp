@@ -1,12 +1,25 @@
 // SPDX-License-Identifier: MIT
 // XML reader and writer for the survey's format (Andersen & Bay, section 4.3 and appendix B).
+//
+// Reading a large file (docs/formats.md, "Reading and writing large XML") is three passes: pugixml parses the
+// text in place; one sequential walk checks the document's structure and lists the <volume> elements in
+// pre-order; then each volume is converted on its own, on all cores when there are many. Any problem found is
+// the first the original one-pass reader would have met, so messages and lines do not depend on the thread
+// count.
 #include "hbvh/io/xml.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
+#include <initializer_list>
+#include <mutex>
 #include <utility>
 
 #include <Eigen/SVD>
@@ -19,13 +32,36 @@
 namespace hbvh {
 namespace {
 
-// The attributes each type takes besides type, name and pos/position. Everything else is rejected:
-// silently ignoring a misspelt `orientaton` would turn an OBB into an AABB without a word.
-constexpr std::array<std::string_view, 3> box_attributes{"width", "depth", "height"};
-constexpr std::array<std::string_view, 4> obb_attributes{"width", "depth", "height", "orientation"};
-constexpr std::array<std::string_view, 1> sphere_attributes{"radius"};
-constexpr std::array<std::string_view, 3> capsule_attributes{"direction", "length", "radius"};
-constexpr std::array<std::string_view, 3> common_attributes{"type", "name", "pos"};
+// The attributes of a <volume>. Everything else is rejected: silently ignoring a misspelt `orientaton`
+// would turn an OBB into an AABB without a word. `position` (the survey's prose) is read as `pos`.
+enum class Key : std::uint8_t { type, name, pos, width, depth, height, orientation, radius, direction, length };
+constexpr std::size_t key_count = 10;
+constexpr std::array<std::string_view, key_count> key_names{"type",   "name",        "pos",    "width",     "depth",
+                                                            "height", "orientation", "radius", "direction", "length"};
+
+constexpr std::uint32_t bit(Key key) { return std::uint32_t{1} << static_cast<unsigned>(key); }
+constexpr std::uint32_t common_keys = bit(Key::type) | bit(Key::name) | bit(Key::pos);
+constexpr std::uint32_t box_keys = bit(Key::width) | bit(Key::depth) | bit(Key::height);
+
+/// The keys a type takes besides type, name and pos.
+std::uint32_t keys_of(BvType type) {
+    switch (type) {
+        case BvType::aabb: return box_keys;
+        case BvType::obb: return box_keys | bit(Key::orientation);
+        case BvType::sphere: return bit(Key::radius);
+        case BvType::capsule: return bit(Key::direction) | bit(Key::length) | bit(Key::radius);
+    }
+    return 0;
+}
+
+std::optional<Key> key_of(std::string_view name) {
+    if (name == "position") return Key::pos;
+    const auto found = std::find(key_names.begin(), key_names.end(), name);
+    if (found == key_names.end()) return std::nullopt;
+    return static_cast<Key>(found - key_names.begin());
+}
+
+std::string key_name(Key key) { return std::string(key_names[static_cast<std::size_t>(key)]); }
 
 bool is_xml_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r'; }
 
@@ -75,68 +111,216 @@ std::string format_numbers(std::initializer_list<double> values) {
 
 std::string format_vector(const Vec3& v) { return format_numbers({v.x(), v.y(), v.z()}); }
 
-/// Parses one XML file. Keeps the text so that byte offsets from pugixml become line numbers.
+/// Where every line of a text starts. Built before pugixml parses the text in place, because that parse
+/// rewrites line ends ("\r\n" and newlines inside attribute values); a lookup is a binary search, so an
+/// error deep in a large file costs no scan of the text before it.
+class LineTable {
+public:
+    explicit LineTable(std::string_view text) : size_(text.size()) {
+        starts_.push_back(0);
+        const char* const begin = text.data();
+        const char* const end = begin + text.size();
+        for (const char* at = begin; at < end; ++at) {
+            at = static_cast<const char*>(std::memchr(at, '\n', static_cast<std::size_t>(end - at)));
+            if (at == nullptr) break;
+            starts_.push_back(static_cast<std::size_t>(at - begin) + 1);
+        }
+    }
+
+    /// The 1-based line of byte `offset`, clamped into the text (a negative offset is on line 1).
+    [[nodiscard]] int line_of(std::ptrdiff_t offset) const {
+        const auto at = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(offset, 0, static_cast<std::ptrdiff_t>(size_)));
+        return static_cast<int>(std::upper_bound(starts_.begin(), starts_.end(), at) - starts_.begin());
+    }
+
+    /// The lines of ascending offsets, in one forward sweep of the table (no search per offset).
+    [[nodiscard]] std::vector<int> lines_of_ascending(std::span<const std::ptrdiff_t> offsets) const {
+        std::vector<int> lines;
+        lines.reserve(offsets.size());
+        std::size_t line = 1;  // starts_[line - 1] <= offset < starts_[line]
+        for (const std::ptrdiff_t offset : offsets) {
+            const auto at = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(offset, 0, static_cast<std::ptrdiff_t>(size_)));
+            HBVH_ASSERT(at >= starts_[line - 1]);
+            while (line < starts_.size() && starts_[line] <= at) ++line;
+            lines.push_back(static_cast<int>(line));
+        }
+        return lines;
+    }
+
+private:
+    std::size_t size_;
+    std::vector<std::size_t> starts_;
+};
+
+/// Whether pugixml's in-place parse can change the white space that opens a text node: a lone '\r' becomes
+/// '\n' and a character reference ("&#10;") the white space it stands for. Without either, the newlines at
+/// the start of a parsed text are the file's own ("\r\n" becomes one '\n'), so its line can be counted there.
+bool parse_can_rewrite_white_space(std::string_view text) {
+    if (text.find("&#") != std::string_view::npos) return true;
+    for (std::size_t cr = text.find('\r'); cr != std::string_view::npos; cr = text.find('\r', cr + 1))
+        if (cr + 1 == text.size() || text[cr + 1] != '\n') return true;
+    return false;
+}
+
+constexpr std::uint32_t no_parent = UINT32_MAX;
+
+/// Above this many volumes the conversion runs on all cores; below, starting tasks costs more than it saves.
+constexpr std::size_t parallel_volume_count = 16384;
+
+/// One <volume> element as the structure walk met it, in document pre-order (which lists the leaves, the
+/// primitives, in document order, and every volume after its parent).
+struct VolumeElement {
+    pugi::xml_node element;
+    std::uint32_t parent = no_parent;  ///< Index of the enclosing volume in the walk, or no_parent.
+    std::uint32_t slot = 0;            ///< A leaf's primitive index, else the index among the inner volumes.
+    bool is_leaf = true;
+};
+
+/// What the structure walk found. A problem of structure is reported only if no volume up to and including
+/// `problem_after` is bad: that is the order in which the one-pass reader met them.
+struct VolumeWalk {
+    std::vector<VolumeElement> volumes;
+    std::uint32_t primitive_count = 0;
+    std::uint32_t inner_count = 0;
+    pugi::xml_node second_top_level;  ///< Null when there is one top-level volume.
+    bool nested = false;
+    std::optional<Error> problem;
+    std::size_t problem_after = 0;
+};
+
+/// A volume as read from its element; `name` points into the parsed text.
+struct ParsedVolume {
+    BoundingVolume volume;
+    std::string_view name;
+};
+
+/// A <volume>'s attributes by key, each given once; null where absent.
+using VolumeAttributes = std::array<pugi::xml_attribute, key_count>;
+
+/// The failure with the lowest order key reported from any thread. Keys grow in document order, so this is
+/// the failure a one-pass reader would meet first; work whose key is higher than a known failure's is useless.
+class FirstFailure {
+public:
+    [[nodiscard]] bool is_known_before(std::size_t key) const { return key_.load(std::memory_order_relaxed) < key; }
+    void report(std::size_t key, Error error) {
+        const std::lock_guard lock(mutex_);
+        if (key >= key_.load(std::memory_order_relaxed)) return;
+        key_.store(key, std::memory_order_relaxed);
+        error_ = std::move(error);
+    }
+    [[nodiscard]] std::optional<Error> take() && { return std::move(error_); }
+
+private:
+    std::atomic<std::size_t> key_{SIZE_MAX};
+    std::mutex mutex_;
+    std::optional<Error> error_;
+};
+
+/// Parses one XML file. Owns the text, which pugixml parses in place.
 class Reader {
 public:
-    Reader(std::string_view text, std::string_view source) : text_(text), source_(source), buffer_(text) {}
+    Reader(std::string text, std::string_view source) : text_(std::move(text)), lines_(text_), source_(source) {
+        if (parse_can_rewrite_white_space(text_)) pristine_ = text_;
+    }
 
     Result<XmlModel> run();
 
 private:
-    /// One <volume> as read, in document (pre-)order.
-    struct Item {
-        BoundingVolume volume;
-        std::string name;
-        std::vector<std::uint32_t> children;  ///< Indices of the child items, in document order.
-        std::ptrdiff_t offset = 0;            ///< The element's byte offset, for its line.
-    };
-
-    [[nodiscard]] int line_at(std::ptrdiff_t offset) const {
-        const auto end = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(offset, 0, std::ssize(text_)));
-        return 1 + static_cast<int>(std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
-    }
-    /// The line of an element's name, or for text, of its first non-blank character (a stray word
-    /// usually follows the newline that ends the previous tag).
-    [[nodiscard]] int line_of(const pugi::xml_node& node) const {
-        std::ptrdiff_t offset = node.offset_debug();
-        if (node.type() == pugi::node_pcdata || node.type() == pugi::node_cdata)
-            while (offset >= 0 && offset < std::ssize(text_) && is_xml_space(text_[static_cast<std::size_t>(offset)])) ++offset;
-        return line_at(offset);
-    }
-    /// The line of the attribute itself, which can differ from its element's (appendix B puts
-    /// `orientation` on the next line). pugixml parses in place, so the attribute's name points into
-    /// buffer_ at the attribute's own position; anything else falls back to the element's line.
-    [[nodiscard]] int line_of(const pugi::xml_attribute& attribute, const pugi::xml_node& element) const {
-        const char* name = attribute.name();
-        if (name >= buffer_.data() && name < buffer_.data() + buffer_.size()) return line_at(name - buffer_.data());
-        return line_of(element);
-    }
+    [[nodiscard]] int line_at(std::ptrdiff_t offset) const { return lines_.line_of(offset); }
+    [[nodiscard]] int line_of(const pugi::xml_node& node) const;
+    [[nodiscard]] int line_of(const pugi::xml_attribute& attribute, const pugi::xml_node& element) const;
     [[nodiscard]] Error error(int line, std::string message) const { return Error(std::move(message), source_, line); }
 
+    Result<pugi::xml_node> parse_hierarchy();
     std::optional<Error> check_structure_of(const pugi::xml_node& parent, std::vector<pugi::xml_node>& volumes) const;
-    Result<BoundingVolume> read_volume(const pugi::xml_node& element, std::string& name) const;
-    Result<std::vector<double>> read_numbers(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
-                                             std::size_t count) const;
+    Result<VolumeWalk> walk_volumes(const pugi::xml_node& hierarchy) const;
+    std::optional<Error> convert_volumes(const VolumeWalk& walk, std::vector<Primitive>& primitives,
+                                         std::vector<BoundingVolume>& inner_volumes) const;
+    std::optional<Error> convert_volume(const VolumeElement& volume, std::vector<Primitive>& primitives,
+                                        std::vector<BoundingVolume>& inner_volumes) const;
+    void assemble_tree(const VolumeWalk& walk, XmlModel& model, std::vector<BoundingVolume> inner_volumes);
+
+    Result<ParsedVolume> read_volume(const pugi::xml_node& element) const;
+    Result<VolumeAttributes> collect_attributes(const pugi::xml_node& element, BvType type,
+                                                std::string_view type_name) const;
+    Result<BoundingVolume> read_round(const pugi::xml_node& element, const VolumeAttributes& attributes, BvType type,
+                                      const Vec3& centre, std::string_view type_name) const;
+    Result<BoundingVolume> read_box(const pugi::xml_node& element, const VolumeAttributes& attributes,
+                                    const Vec3& centre, std::string_view type_name) const;
+    Result<pugi::xml_attribute> required(const pugi::xml_node& element, const VolumeAttributes& attributes, Key key,
+                                         std::string_view type_name) const;
+    template <std::size_t count>
+    Result<std::array<double, count>> read_numbers(const pugi::xml_node& element,
+                                                   const pugi::xml_attribute& attribute) const;
+    Result<Vec3> read_vector(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
     Result<double> read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
                              bool zero_allowed) const;
     Result<Mat3> read_orientation(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
 
-    std::string_view text_;
+    std::string text_;      // parsed in place by doc_, so declared before it
+    std::string pristine_;  // an unparsed copy, kept only when the parse could move a text's first character
+    LineTable lines_;       // of the text before parsing
     std::string source_;
-    std::string buffer_;  // pugixml's in-place copy; declared before doc_ so it outlives it
     pugi::xml_document doc_;
 };
 
+/// The line of an element's name, or for text, of its first non-blank character (a stray word usually
+/// follows the newline that ends the previous tag).
+int Reader::line_of(const pugi::xml_node& node) const {
+    const std::ptrdiff_t offset = node.offset_debug();
+    if (node.type() != pugi::node_pcdata && node.type() != pugi::node_cdata) return line_at(offset);
+    if (!pristine_.empty()) {
+        std::ptrdiff_t first = offset;
+        while (first >= 0 && first < std::ssize(pristine_) && is_xml_space(pristine_[static_cast<std::size_t>(first)])) ++first;
+        return line_at(first);
+    }
+    // The parsed value starts where the text did, and its leading newlines are the file's own (see
+    // parse_can_rewrite_white_space), so they count the lines to its first non-blank character.
+    int newlines = 0;
+    for (const char* c = node.value(); is_xml_space(*c); ++c) newlines += *c == '\n' ? 1 : 0;
+    return line_at(offset) + newlines;
+}
+
+/// The line of the attribute itself, which can differ from its element's (appendix B puts `orientation` on
+/// the next line). pugixml parses in place, so the attribute's name points into text_ at the attribute's own
+/// position (names are never moved); anything else falls back to the element's line.
+int Reader::line_of(const pugi::xml_attribute& attribute, const pugi::xml_node& element) const {
+    const char* name = attribute.name();
+    if (name >= text_.data() && name < text_.data() + text_.size()) return line_at(name - text_.data());
+    return line_of(element);
+}
+
 Result<XmlModel> Reader::run() {
-    // Stage 1: parse. Whitespace-only input gets its own message: "no element found" would puzzle.
+    Result<pugi::xml_node> hierarchy = parse_hierarchy();
+    if (!hierarchy) return hierarchy.error();
+    Result<VolumeWalk> walk = walk_volumes(*hierarchy);
+    if (!walk) return walk.error();
+
+    XmlModel model;
+    model.primitives.resize(walk->primitive_count);
+    std::vector<BoundingVolume> inner_volumes(walk->inner_count);
+    if (std::optional<Error> problem = convert_volumes(*walk, model.primitives, inner_volumes)) return *std::move(problem);
+    if (!walk->nested) return model;
+
+    // A nested file is one tree. The survey's root is "the first volume element"; a second top-level
+    // volume would need a BV nobody wrote, so it is an error rather than a guess.
+    if (walk->second_top_level)
+        return error(line_of(walk->second_top_level),
+                     "a nested hierarchy must have exactly one top-level <volume>, but this is a second one");
+    assemble_tree(*walk, model, std::move(inner_volumes));
+    return model;
+}
+
+/// Parses the text and finds its one top-level element, <hierarchy>, which must have no attributes.
+Result<pugi::xml_node> Reader::parse_hierarchy() {
+    // Whitespace-only input gets its own message: "no element found" would puzzle.
     std::string_view body = text_;
     if (body.starts_with("\xEF\xBB\xBF")) body.remove_prefix(3);  // a UTF-8 byte order mark
     if (is_blank(body)) return error(1, "file is empty");
     const pugi::xml_parse_result parsed =
-        doc_.load_buffer_inplace(buffer_.data(), buffer_.size(), pugi::parse_default, pugi::encoding_utf8);
+        doc_.load_buffer_inplace(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
     if (!parsed) return error(line_at(parsed.offset), describe_parse_error(parsed));
 
-    // Stage 2: exactly one top-level element, and it is <hierarchy>.
     pugi::xml_node hierarchy;
     for (const pugi::xml_node& node : doc_.children()) {
         if (node.type() != pugi::node_element) continue;
@@ -150,89 +334,7 @@ Result<XmlModel> Reader::run() {
     if (hierarchy.first_attribute())
         return error(line_of(hierarchy.first_attribute(), hierarchy),
                      "unknown attribute '" + excerpt(hierarchy.first_attribute().name()) + "' on <hierarchy>");
-
-    // Stage 3: read every volume in document pre-order with an explicit stack (a deeply nested file
-    // must not overflow the call stack). Pre-order visits the leaves in document order.
-    std::vector<pugi::xml_node> top_level;
-    if (auto problem = check_structure_of(hierarchy, top_level)) return *problem;
-    if (top_level.empty()) return error(line_of(hierarchy), "<hierarchy> contains no <volume> elements");
-
-    std::vector<Item> items;
-    std::vector<std::pair<pugi::xml_node, std::uint32_t>> stack;  // (element, parent item or UINT32_MAX)
-    constexpr std::uint32_t no_parent = UINT32_MAX;
-    for (auto it = top_level.rbegin(); it != top_level.rend(); ++it) stack.emplace_back(*it, no_parent);
-    bool nested = false;
-    while (!stack.empty()) {
-        const auto [element, parent] = stack.back();
-        stack.pop_back();
-        std::string name;
-        Result<BoundingVolume> volume = read_volume(element, name);
-        if (!volume) return volume.error();
-        // Each number can be finite while what is derived from them is not (a box's centre from corners near
-        // 1e308, a capsule's length beyond 1e154); such a volume could not be written back or fitted.
-        if (!detail::is_representable(*volume))
-            return error(line_of(element), "volume's centre, length or extents overflow the range of double");
-        const auto index = static_cast<std::uint32_t>(items.size());
-        items.push_back({std::move(volume).value(), std::move(name), {}, element.offset_debug()});
-        if (parent != no_parent) items[parent].children.push_back(index);
-
-        std::vector<pugi::xml_node> children;
-        if (auto problem = check_structure_of(element, children)) return *problem;
-        nested = nested || !children.empty();
-        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(*it, index);
-    }
-
-    // Stage 4: the leaves are the primitives, numbered in document order.
-    XmlModel model;
-    std::vector<std::uint32_t> primitive_of(items.size(), 0);
-    for (std::uint32_t i = 0; i < items.size(); ++i) {
-        if (!items[i].children.empty()) continue;
-        primitive_of[i] = static_cast<std::uint32_t>(model.primitives.size());
-        model.primitives.push_back({items[i].volume, std::move(items[i].name)});
-    }
-    if (!nested) return model;
-
-    // Stage 5: a nested file is one tree. The survey's root is "the first volume element"; a second
-    // top-level volume would need a BV nobody wrote, so it is an error rather than a guess.
-    if (top_level.size() > 1)
-        return error(line_of(top_level[1]),
-                     "a nested hierarchy must have exactly one top-level <volume>, but this is a second one");
-    // Children come after their parent in pre-order, so walking backwards meets every child before its
-    // parent, as TreeAssembler::add_group needs. It also collapses single-child volumes.
-    TreeAssembler assembler(model.primitives);
-    std::vector<std::uint32_t> id(items.size(), 0);
-    for (std::size_t i = items.size(); i-- > 0;) {
-        Item& item = items[i];
-        if (item.children.empty()) {
-            id[i] = assembler.add_leaf(primitive_of[i]);
-            continue;
-        }
-        std::vector<std::uint32_t> child_ids;
-        child_ids.reserve(item.children.size());
-        for (std::uint32_t child : item.children) child_ids.push_back(id[child]);
-        id[i] = assembler.add_group(child_ids, item.volume);
-    }
-    std::vector<std::uint32_t> assembler_id_of_node;
-    model.hierarchy = std::move(assembler).finish(id[0], &assembler_id_of_node);
-    // Every node's line in one pass over the text: item offsets grow in pre-order, so sorting the nodes by
-    // offset lets one forward scan count the newlines (line_at per node would be quadratic in big files).
-    std::vector<std::uint32_t> item_of_assembler_id(items.size());
-    for (std::uint32_t i = 0; i < items.size(); ++i) item_of_assembler_id[id[i]] = i;
-    std::vector<std::pair<std::ptrdiff_t, std::uint32_t>> offsets;  // (offset, node)
-    offsets.reserve(assembler_id_of_node.size());
-    for (std::uint32_t n = 0; n < assembler_id_of_node.size(); ++n)
-        offsets.emplace_back(items[item_of_assembler_id[assembler_id_of_node[n]]].offset, n);
-    std::sort(offsets.begin(), offsets.end());
-    model.node_lines.assign(offsets.size(), 0);
-    std::ptrdiff_t scanned = 0;
-    int line = 1;
-    for (const auto& [offset, node] : offsets) {
-        const std::ptrdiff_t end = std::clamp<std::ptrdiff_t>(offset, scanned, std::ssize(text_));
-        line += static_cast<int>(std::count(text_.begin() + scanned, text_.begin() + end, '\n'));
-        scanned = end;
-        model.node_lines[node] = line;
-    }
-    return model;
+    return hierarchy;
 }
 
 /// Collects the <volume> children of `parent` and rejects anything else that holds information
@@ -258,102 +360,224 @@ std::optional<Error> Reader::check_structure_of(const pugi::xml_node& parent, st
     return std::nullopt;
 }
 
-Result<BoundingVolume> Reader::read_volume(const pugi::xml_node& element, std::string& name) const {
-    // Lines are found by counting newlines from the start, so they are computed only for an error.
-    const auto element_line = [&] { return line_of(element); };
+/// Lists every volume in document pre-order with an explicit stack (a deeply nested file must not overflow
+/// the call stack), checking what each element contains. Problems inside <hierarchy> itself come first, as
+/// they did when this walk and the conversion were one loop; a problem inside a volume is kept for later.
+Result<VolumeWalk> Reader::walk_volumes(const pugi::xml_node& hierarchy) const {
+    std::vector<pugi::xml_node> top_level;
+    if (auto problem = check_structure_of(hierarchy, top_level)) return *std::move(problem);
+    if (top_level.empty()) return error(line_of(hierarchy), "<hierarchy> contains no <volume> elements");
+    VolumeWalk walk;
+    walk.volumes.reserve(top_level.size());
+    if (top_level.size() > 1) walk.second_top_level = top_level[1];
 
+    std::vector<std::pair<pugi::xml_node, std::uint32_t>> stack;  // (element, parent volume)
+    for (auto it = top_level.rbegin(); it != top_level.rend(); ++it) stack.emplace_back(*it, no_parent);
+    std::vector<pugi::xml_node> children;
+    while (!stack.empty()) {
+        const auto [element, parent] = stack.back();
+        stack.pop_back();
+        const auto index = static_cast<std::uint32_t>(walk.volumes.size());
+        VolumeElement& volume = walk.volumes.emplace_back(VolumeElement{element, parent});
+        children.clear();
+        if (auto problem = check_structure_of(element, children)) {
+            volume.slot = walk.primitive_count++;  // converted like the volumes before it, then dropped
+            walk.problem = std::move(problem);
+            walk.problem_after = index;
+            break;
+        }
+        volume.is_leaf = children.empty();
+        volume.slot = volume.is_leaf ? walk.primitive_count++ : walk.inner_count++;
+        walk.nested = walk.nested || !volume.is_leaf;
+        for (auto it = children.rbegin(); it != children.rend(); ++it) stack.emplace_back(*it, index);
+    }
+    return walk;
+}
+
+/// Converts every walked volume into its primitive or inner volume, on all cores for a large file. Each
+/// volume has two order keys, 2i for its own problems and 2i + 1 for a problem of structure found inside it,
+/// so the error returned is the one the one-pass reader met first, whatever the thread count.
+std::optional<Error> Reader::convert_volumes(const VolumeWalk& walk, std::vector<Primitive>& primitives,
+                                             std::vector<BoundingVolume>& inner_volumes) const {
+    FirstFailure first;
+    if (walk.problem) first.report(2 * walk.problem_after + 1, *walk.problem);
+    const auto convert_range = [&](std::size_t begin, std::size_t end) {
+        for (std::size_t i = begin; i < end && !first.is_known_before(2 * i); ++i)
+            if (std::optional<Error> problem = convert_volume(walk.volumes[i], primitives, inner_volumes))
+                first.report(2 * i, *std::move(problem));
+    };
+    const std::size_t count = walk.volumes.size();
+    if (count < parallel_volume_count) {
+        convert_range(0, count);
+    } else {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1024),
+                          [&](const tbb::blocked_range<std::size_t>& range) { convert_range(range.begin(), range.end()); });
+    }
+    return std::move(first).take();
+}
+
+/// Reads one volume into its own slot (each slot belongs to one volume, so threads never share one).
+std::optional<Error> Reader::convert_volume(const VolumeElement& volume, std::vector<Primitive>& primitives,
+                                            std::vector<BoundingVolume>& inner_volumes) const {
+    Result<ParsedVolume> parsed = read_volume(volume.element);
+    if (!parsed) return parsed.error();
+    // Each number can be finite while what is derived from them is not (a box's centre from corners near
+    // 1e308, a capsule's length beyond 1e154); such a volume could not be written back or fitted.
+    if (!detail::is_representable(parsed->volume))
+        return error(line_of(volume.element), "volume's centre, length or extents overflow the range of double");
+    if (volume.is_leaf) {
+        primitives[volume.slot] = Primitive{std::move(parsed->volume), std::string(parsed->name)};
+    } else {
+        inner_volumes[volume.slot] = std::move(parsed->volume);
+    }
+    return std::nullopt;
+}
+
+/// Builds the tree of a nested file and each node's line. The leaves are the primitives, numbered in
+/// document order, which `model.primitives` already holds.
+void Reader::assemble_tree(const VolumeWalk& walk, XmlModel& model, std::vector<BoundingVolume> inner_volumes) {
+    const std::vector<VolumeElement>& volumes = walk.volumes;
+    std::vector<std::ptrdiff_t> offsets;  // ascending: pre-order is document order
+    offsets.reserve(volumes.size());
+    for (const VolumeElement& volume : volumes) offsets.push_back(volume.element.offset_debug());
+    const std::vector<int> element_lines = lines_.lines_of_ascending(offsets);
+    // The document and its text are no longer needed; the tree needs memory of its own.
+    doc_.reset();
+    std::string().swap(text_);
+    std::string().swap(pristine_);
+
+    // Each volume's children in document order, as ranges of one array (pre-order lists them in order).
+    std::vector<std::uint32_t> first_child(volumes.size() + 1, 0);
+    for (const VolumeElement& volume : volumes)
+        if (volume.parent != no_parent) ++first_child[volume.parent + 1];
+    for (std::size_t i = 0; i < volumes.size(); ++i) first_child[i + 1] += first_child[i];
+    std::vector<std::uint32_t> children(volumes.size());
+    std::vector<std::uint32_t> filled(first_child.begin(), first_child.end() - 1);
+    for (std::uint32_t i = 0; i < volumes.size(); ++i)
+        if (volumes[i].parent != no_parent) children[filled[volumes[i].parent]++] = i;
+
+    // Children come after their parent in pre-order, so walking backwards meets every child before its
+    // parent, as TreeAssembler::add_group needs. It also collapses single-child volumes.
+    TreeAssembler assembler(model.primitives);
+    std::vector<std::uint32_t> id(volumes.size(), 0);
+    std::vector<std::uint32_t> child_ids;
+    for (std::size_t i = volumes.size(); i-- > 0;) {
+        if (volumes[i].is_leaf) {
+            id[i] = assembler.add_leaf(volumes[i].slot);
+            continue;
+        }
+        child_ids.clear();
+        for (std::uint32_t c = first_child[i]; c < first_child[i + 1]; ++c) child_ids.push_back(id[children[c]]);
+        id[i] = assembler.add_group(child_ids, std::move(inner_volumes[volumes[i].slot]));
+    }
+    std::vector<std::uint32_t> assembler_id_of_node;
+    model.hierarchy = std::move(assembler).finish(id[0], &assembler_id_of_node);
+
+    std::vector<std::uint32_t> volume_of_assembler_id(volumes.size());
+    for (std::uint32_t i = 0; i < volumes.size(); ++i) volume_of_assembler_id[id[i]] = i;
+    model.node_lines.reserve(assembler_id_of_node.size());
+    for (const std::uint32_t assembler_id : assembler_id_of_node)
+        model.node_lines.push_back(element_lines[volume_of_assembler_id[assembler_id]]);
+}
+
+Result<ParsedVolume> Reader::read_volume(const pugi::xml_node& element) const {
     // Stage 1: the type decides which attributes are allowed.
     const pugi::xml_attribute type_attribute = element.attribute("type");
-    if (!type_attribute) return error(element_line(), "missing attribute 'type' on <volume>");
+    if (!type_attribute) return error(line_of(element), "missing attribute 'type' on <volume>");
     const std::string_view type_name = type_attribute.value();
     const std::optional<BvType> type = parse_bv_type(type_name);
     if (!type)
         return error(line_of(type_attribute, element),
                      "unknown volume type \"" + excerpt(type_name) + "\" (expected aabb, obb, sphere or capsule)");
-    std::span<const std::string_view> specific;
-    switch (*type) {
-        case BvType::aabb: specific = box_attributes; break;
-        case BvType::obb: specific = obb_attributes; break;
-        case BvType::sphere: specific = sphere_attributes; break;
-        case BvType::capsule: specific = capsule_attributes; break;
-    }
 
-    // Stage 2: every attribute is known, allowed for this type and given once. `position` is the
-    // survey's prose spelling of `pos`, so both count as the same attribute.
-    pugi::xml_attribute position;
-    for (const pugi::xml_attribute& attribute : element.attributes()) {
-        std::string_view key = attribute.name();
-        const auto line = [&] { return line_of(attribute, element); };
-        if (key == "position") key = "pos";
-        const bool is_common = std::find(common_attributes.begin(), common_attributes.end(), key) != common_attributes.end();
-        const bool is_specific = std::find(specific.begin(), specific.end(), key) != specific.end();
-        if (!is_common && !is_specific) {
-            const bool elsewhere = std::find(obb_attributes.begin(), obb_attributes.end(), key) != obb_attributes.end() ||
-                                   key == "radius" || key == "direction" || key == "length";
-            if (elsewhere)
-                return error(line(), "attribute '" + std::string(key) + "' does not apply to type=\"" +
-                                       std::string(type_name) + "\"");
-            return error(line(), "unknown attribute '" + excerpt(attribute.name()) + "' on <volume type=\"" +
-                                   std::string(type_name) + "\">");
-        }
-        for (pugi::xml_attribute earlier = element.first_attribute(); earlier != attribute;
-             earlier = earlier.next_attribute()) {
-            std::string_view earlier_key = earlier.name();
-            if (earlier_key == "position") earlier_key = "pos";
-            if (earlier_key != key) continue;
-            if (std::string_view(earlier.name()) != attribute.name())
-                return error(line(), "both 'pos' and 'position' given; use one");
-            return error(line(), "attribute '" + std::string(key) + "' given twice");
-        }
-        if (key == "pos") position = attribute;
-    }
-    auto required = [&](std::string_view key) -> Result<pugi::xml_attribute> {
-        const pugi::xml_attribute attribute = element.attribute(std::string(key).c_str());
-        if (!attribute)
-            return error(element_line(),
-                         "missing attribute '" + std::string(key) + "' on <volume type=\"" + std::string(type_name) + "\">");
-        return attribute;
-    };
-    if (!position) return error(element_line(), "missing attribute 'pos' on <volume type=\"" + std::string(type_name) + "\">");
-    name = element.attribute("name").value();
+    // Stage 2: every attribute is known, allowed for this type and given once.
+    Result<VolumeAttributes> attributes = collect_attributes(element, *type, type_name);
+    if (!attributes) return attributes.error();
+    const pugi::xml_attribute position = (*attributes)[static_cast<std::size_t>(Key::pos)];
+    if (!position) return error(line_of(element), "missing attribute 'pos' on <volume type=\"" + std::string(type_name) + "\">");
+    const std::string_view name = (*attributes)[static_cast<std::size_t>(Key::name)].value();
 
     // Stage 3: read the numbers.
-    const Result<std::vector<double>> centre_numbers = read_numbers(element, position, 3);
-    if (!centre_numbers) return centre_numbers.error();
-    const Vec3 centre(centre_numbers.value()[0], centre_numbers.value()[1], centre_numbers.value()[2]);
+    const Result<Vec3> centre = read_vector(element, position);
+    if (!centre) return centre.error();
+    Result<BoundingVolume> volume = *type == BvType::sphere || *type == BvType::capsule
+                                        ? read_round(element, *attributes, *type, *centre, type_name)
+                                        : read_box(element, *attributes, *centre, type_name);
+    if (!volume) return volume.error();
+    return ParsedVolume{std::move(volume).value(), name};
+}
 
-    if (*type == BvType::sphere || *type == BvType::capsule) {
-        const Result<pugi::xml_attribute> radius_attribute = required("radius");
-        if (!radius_attribute) return radius_attribute.error();
-        const Result<double> radius = read_size(element, *radius_attribute, false);
-        if (!radius) return radius.error();
-        if (*type == BvType::sphere) return BoundingVolume(Sphere{centre, *radius});
-
-        const Result<pugi::xml_attribute> direction_attribute = required("direction");
-        if (!direction_attribute) return direction_attribute.error();
-        const Result<std::vector<double>> direction_numbers = read_numbers(element, *direction_attribute, 3);
-        if (!direction_numbers) return direction_numbers.error();
-        const Vec3 direction(direction_numbers.value()[0], direction_numbers.value()[1], direction_numbers.value()[2]);
-        // stableNorm: a tiny but valid direction like (1e-200, 0, 0) must not underflow to zero.
-        const double norm = direction.stableNorm();
-        if (!(norm > 0.0) || !std::isfinite(norm))
-            return error(line_of(*direction_attribute, element), "attribute 'direction' must not be the zero vector");
-        const Result<pugi::xml_attribute> length_attribute = required("length");
-        if (!length_attribute) return length_attribute.error();
-        // Length 0 is a sphere written as a capsule; that is still a valid capsule.
-        const Result<double> length = read_size(element, *length_attribute, true);
-        if (!length) return length.error();
-        const Vec3 half_axis = (0.5 * *length) * Vec3(direction / norm);
-        const Capsule capsule{centre - half_axis, centre + half_axis, *radius};
-        if (!capsule.p0.allFinite() || !capsule.p1.allFinite())
-            return error(element_line(), "capsule ends overflow the range of double");
-        return BoundingVolume(capsule);
+/// Each attribute of `element` by its key, in one pass; the first unknown, misplaced or repeated one is an
+/// error at its own line.
+Result<VolumeAttributes> Reader::collect_attributes(const pugi::xml_node& element, BvType type,
+                                                    std::string_view type_name) const {
+    const std::uint32_t allowed = common_keys | keys_of(type);
+    VolumeAttributes attributes{};
+    for (const pugi::xml_attribute& attribute : element.attributes()) {
+        const std::string_view spelled = attribute.name();
+        const std::optional<Key> key = key_of(spelled);
+        const auto line = [&] { return line_of(attribute, element); };
+        if (!key)
+            return error(line(), "unknown attribute '" + excerpt(spelled) + "' on <volume type=\"" +
+                                     std::string(type_name) + "\">");
+        if ((allowed & bit(*key)) == 0)
+            return error(line(), "attribute '" + key_name(*key) + "' does not apply to type=\"" + std::string(type_name) + "\"");
+        pugi::xml_attribute& earlier = attributes[static_cast<std::size_t>(*key)];
+        if (earlier) {
+            if (std::string_view(earlier.name()) != spelled) return error(line(), "both 'pos' and 'position' given; use one");
+            return error(line(), "attribute '" + key_name(*key) + "' given twice");
+        }
+        earlier = attribute;
     }
+    return attributes;
+}
 
-    // Boxes: full extents along the local x, y, z axes.
+Result<pugi::xml_attribute> Reader::required(const pugi::xml_node& element, const VolumeAttributes& attributes, Key key,
+                                             std::string_view type_name) const {
+    const pugi::xml_attribute attribute = attributes[static_cast<std::size_t>(key)];
+    if (!attribute)
+        return error(line_of(element),
+                     "missing attribute '" + key_name(key) + "' on <volume type=\"" + std::string(type_name) + "\">");
+    return attribute;
+}
+
+/// A sphere, or a capsule: `pos` is the centre of its segment.
+Result<BoundingVolume> Reader::read_round(const pugi::xml_node& element, const VolumeAttributes& attributes, BvType type,
+                                          const Vec3& centre, std::string_view type_name) const {
+    const Result<pugi::xml_attribute> radius_attribute = required(element, attributes, Key::radius, type_name);
+    if (!radius_attribute) return radius_attribute.error();
+    const Result<double> radius = read_size(element, *radius_attribute, false);
+    if (!radius) return radius.error();
+    if (type == BvType::sphere) return BoundingVolume(Sphere{centre, *radius});
+
+    const Result<pugi::xml_attribute> direction_attribute = required(element, attributes, Key::direction, type_name);
+    if (!direction_attribute) return direction_attribute.error();
+    const Result<Vec3> direction = read_vector(element, *direction_attribute);
+    if (!direction) return direction.error();
+    // stableNorm: a tiny but valid direction like (1e-200, 0, 0) must not underflow to zero.
+    const double norm = direction->stableNorm();
+    if (!(norm > 0.0) || !std::isfinite(norm))
+        return error(line_of(*direction_attribute, element), "attribute 'direction' must not be the zero vector");
+    const Result<pugi::xml_attribute> length_attribute = required(element, attributes, Key::length, type_name);
+    if (!length_attribute) return length_attribute.error();
+    // Length 0 is a sphere written as a capsule; that is still a valid capsule.
+    const Result<double> length = read_size(element, *length_attribute, true);
+    if (!length) return length.error();
+    const Vec3 half_axis = (0.5 * *length) * Vec3(*direction / norm);
+    const Capsule capsule{centre - half_axis, centre + half_axis, *radius};
+    if (!capsule.p0.allFinite() || !capsule.p1.allFinite())
+        return error(line_of(element), "capsule ends overflow the range of double");
+    return BoundingVolume(capsule);
+}
+
+/// A box: full extents along its local x, y, z axes; an OBB when it has an orientation, else an AABB.
+Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const VolumeAttributes& attributes,
+                                        const Vec3& centre, std::string_view type_name) const {
     Vec3 extents;
+    constexpr std::array<Key, 3> axes{Key::width, Key::depth, Key::height};
     for (int axis = 0; axis < 3; ++axis) {
-        const Result<pugi::xml_attribute> attribute = required(box_attributes[static_cast<std::size_t>(axis)]);
+        const Result<pugi::xml_attribute> attribute =
+            required(element, attributes, axes[static_cast<std::size_t>(axis)], type_name);
         if (!attribute) return attribute.error();
         const Result<double> extent = read_size(element, *attribute, false);
         if (!extent) return extent.error();
@@ -361,15 +585,15 @@ Result<BoundingVolume> Reader::read_volume(const pugi::xml_node& element, std::s
     }
     const Vec3 half = 0.5 * extents;
     // The survey's footnote 4: "AABBs are OBBs with no orientation".
-    const pugi::xml_attribute orientation_attribute = element.attribute("orientation");
+    const pugi::xml_attribute orientation_attribute = attributes[static_cast<std::size_t>(Key::orientation)];
     if (!orientation_attribute) {
         // Stored as corners, an AABB can lose what the file says: far from the origin a small extent
         // rounds away, and a huge one overflows. Refuse instead of returning a flat or infinite box.
         const Aabb box{centre - half, centre + half};
         if (!box.min.allFinite() || !box.max.allFinite())
-            return error(element_line(), "box corners overflow the range of double");
+            return error(line_of(element), "box corners overflow the range of double");
         if (((box.max - box.min).array() <= 0.0).any())
-            return error(element_line(), "box extents vanish in rounding: they are too small for its position");
+            return error(line_of(element), "box extents vanish in rounding: they are too small for its position");
         return BoundingVolume(box);
     }
     const Result<Mat3> rotation = read_orientation(element, orientation_attribute);
@@ -377,60 +601,64 @@ Result<BoundingVolume> Reader::read_volume(const pugi::xml_node& element, std::s
     return BoundingVolume(Obb{centre, *rotation, half});
 }
 
-Result<std::vector<double>> Reader::read_numbers(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
-                                                 std::size_t count) const {
+/// Exactly `count` whitespace-separated finite numbers, parsed straight from the attribute's text.
+template <std::size_t count>
+Result<std::array<double, count>> Reader::read_numbers(const pugi::xml_node& element,
+                                                       const pugi::xml_attribute& attribute) const {
     const auto line = [&] { return line_of(attribute, element); };
-    const std::string key = attribute.name();
-    std::string_view rest = attribute.value();
-    std::vector<double> numbers;
+    const auto key = [&] { return std::string(attribute.name()); };
+    const auto needs = [&] { return "attribute '" + key() + "' needs " + std::to_string(count) + (count == 1 ? " number" : " numbers"); };
+    // Tokens are cut from the value's C string as it is scanned: measuring it first would read it twice.
+    const char* rest = attribute.value();
+    std::array<double, count> numbers{};
+    std::size_t found = 0;
     for (;;) {
-        while (!rest.empty() && is_xml_space(rest.front())) rest.remove_prefix(1);
-        if (rest.empty()) break;
-        std::size_t length = 0;
-        while (length < rest.size() && !is_xml_space(rest[length])) ++length;
-        std::string_view token = rest.substr(0, length);
-        rest.remove_prefix(length);
-        if (numbers.size() == count) {
-            return error(line(), "attribute '" + key + "' needs " + std::to_string(count) +
-                                     (count == 1 ? " number" : " numbers") + ", found more (extra \"" +
-                                   excerpt(token) + "\")");
-        }
+        while (is_xml_space(*rest)) ++rest;
+        if (*rest == '\0') break;
+        const char* token_end = rest;
+        while (*token_end != '\0' && !is_xml_space(*token_end)) ++token_end;
+        const std::string_view token(rest, static_cast<std::size_t>(token_end - rest));
+        rest = token_end;
+        if (found == count) return error(line(), needs() + ", found more (extra \"" + excerpt(token) + "\")");
         // from_chars refuses a leading '+', which people do write; accept it unless a sign follows.
         std::string_view digits = token;
         if (digits.size() > 1 && digits.front() == '+' && digits[1] != '-' && digits[1] != '+') digits.remove_prefix(1);
         double value = 0.0;
         const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
         if (ec == std::errc::result_out_of_range)
-            return error(line(), "attribute '" + key + "': \"" + excerpt(token) + "\" is out of the range of double");
+            return error(line(), "attribute '" + key() + "': \"" + excerpt(token) + "\" is out of the range of double");
         if (ec != std::errc{} || end != digits.data() + digits.size())
-            return error(line(), "attribute '" + key + "': \"" + excerpt(token) + "\" is not a number");
+            return error(line(), "attribute '" + key() + "': \"" + excerpt(token) + "\" is not a number");
         if (!std::isfinite(value))
-            return error(line(), "attribute '" + key + "': \"" + excerpt(token) + "\" is not a finite number");
-        numbers.push_back(value);
+            return error(line(), "attribute '" + key() + "': \"" + excerpt(token) + "\" is not a finite number");
+        numbers[found++] = value;
     }
-    if (numbers.size() != count) {
-        return error(line(), "attribute '" + key + "' needs " + std::to_string(count) +
-                                 (count == 1 ? " number" : " numbers") + ", found " + std::to_string(numbers.size()));
-    }
+    if (found != count) return error(line(), needs() + ", found " + std::to_string(found));
     return numbers;
+}
+
+Result<Vec3> Reader::read_vector(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const {
+    const Result<std::array<double, 3>> numbers = read_numbers<3>(element, attribute);
+    if (!numbers) return numbers.error();
+    return Vec3((*numbers)[0], (*numbers)[1], (*numbers)[2]);
 }
 
 Result<double> Reader::read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
                                  bool zero_allowed) const {
-    const Result<std::vector<double>> numbers = read_numbers(element, attribute, 1);
+    const Result<std::array<double, 1>> numbers = read_numbers<1>(element, attribute);
     if (!numbers) return numbers.error();
-    const double value = numbers.value()[0];
+    const double value = (*numbers)[0];
     if (value > 0.0 || (zero_allowed && value == 0.0)) return value;
     return error(line_of(attribute, element), "attribute '" + std::string(attribute.name()) + "' must be " +
                                                   (zero_allowed ? ">= 0" : "> 0") + ", found " + attribute.value());
 }
 
 Result<Mat3> Reader::read_orientation(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const {
-    const Result<std::vector<double>> numbers = read_numbers(element, attribute, 9);
+    const Result<std::array<double, 9>> numbers = read_numbers<9>(element, attribute);
     if (!numbers) return numbers.error();
     Mat3 m;
     for (int row = 0; row < 3; ++row)
-        for (int column = 0; column < 3; ++column) m(row, column) = numbers.value()[static_cast<std::size_t>(3 * row + column)];
+        for (int column = 0; column < 3; ++column) m(row, column) = (*numbers)[static_cast<std::size_t>(3 * row + column)];
 
     // Files print matrices rounded (appendix B uses one decimal), so accept what is clearly meant as a
     // rotation and replace it by the nearest one; refuse what is not, rather than guess.
@@ -514,13 +742,14 @@ std::string save(const pugi::xml_document& doc) {
 }  // namespace
 
 Result<XmlModel> read_xml_string(std::string_view text, std::string_view source_name) {
-    return Reader(text, source_name).run();
+    return Reader(std::string(text), source_name).run();
 }
 
 Result<XmlModel> read_xml_file(const std::filesystem::path& path) {
     Result<std::string> text = read_text_file(path);
     if (!text) return text.error();
-    return read_xml_string(*text, path.string());
+    // The reader takes the file's bytes over and parses them in place: no copy of a large file.
+    return Reader(std::move(text).value(), path.string()).run();
 }
 
 std::string write_xml(const Bvh& bvh) {
