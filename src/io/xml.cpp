@@ -5,7 +5,7 @@
 // text in place; one sequential walk checks the document's structure and lists the <volume> elements in
 // pre-order; then each volume is converted on its own, on all cores when there are many. Any problem found is
 // the first the original one-pass reader would have met, so messages and lines do not depend on the thread
-// count.
+// count. Writing formats the text directly (no DOM), byte for byte as pugixml's `save` did.
 #include "hbvh/io/xml.hpp"
 
 #include <tbb/blocked_range.h>
@@ -99,17 +99,6 @@ void append_number(std::string& out, double value) {
     const auto [end, ec] = std::to_chars(digits.data(), digits.data() + digits.size(), value);
     out.append(digits.data(), ec == std::errc{} ? end : digits.data());
 }
-
-std::string format_numbers(std::initializer_list<double> values) {
-    std::string out;
-    for (double value : values) {
-        if (!out.empty()) out += ' ';
-        append_number(out, value);
-    }
-    return out;
-}
-
-std::string format_vector(const Vec3& v) { return format_numbers({v.x(), v.y(), v.z()}); }
 
 /// Where every line of a text starts. Built before pugixml parses the text in place, because that parse
 /// rewrites line ends ("\r\n" and newlines inside attribute values); a lookup is a binary search, so an
@@ -681,63 +670,161 @@ Result<Mat3> Reader::read_orientation(const pugi::xml_node& element, const pugi:
     return Mat3(svd.matrixU() * svd.matrixV().transpose());
 }
 
-/// Sets the attributes of one <volume> for `bv`. Attribute order: type, name, pos, then the type's own.
-void write_volume(pugi::xml_node element, const BoundingVolume& bv, const std::string& name) {
-    element.append_attribute("type").set_value(std::string(to_string(type_of(bv))).c_str());
-    if (!name.empty()) element.append_attribute("name").set_value(name.c_str());
-    auto set = [&](const char* key, const std::string& value) { element.append_attribute(key).set_value(value.c_str()); };
+// Writing. The text is what pugixml's save(format_indent, two spaces) wrote when the writer built a DOM:
+// the declaration, one element per line, children indented by two spaces, empty elements closed by " />".
+
+constexpr std::string_view declaration = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
+
+/// An attribute value as pugixml escapes it: & < " as entities (not >, which needs none in a value), control characters as "&#NN;" (two
+/// digits), everything else, UTF-8 included, as it is. pugixml took the value as a C string, so a name
+/// ends at its first NUL.
+void append_escaped(std::string& out, std::string_view text) {
+    text = text.substr(0, text.find('\0'));
+    for (const char c : text) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '"': out += "&quot;"; break;
+            default:
+                if (static_cast<unsigned char>(c) < 32) {
+                    const auto code = static_cast<unsigned char>(c);
+                    out += "&#";
+                    out += static_cast<char>('0' + code / 10);
+                    out += static_cast<char>('0' + code % 10);
+                    out += ';';
+                } else {
+                    out += c;
+                }
+        }
+    }
+}
+
+/// ` key="n0 n1 ..."`, each number in its shortest round-trip form.
+void append_numbers(std::string& out, std::string_view key, std::initializer_list<double> values) {
+    out += ' ';
+    out += key;
+    out += "=\"";
+    bool first = true;
+    for (const double value : values) {
+        if (!first) out += ' ';
+        first = false;
+        append_number(out, value);
+    }
+    out += '"';
+}
+
+void append_vector(std::string& out, std::string_view key, const Vec3& v) { append_numbers(out, key, {v.x(), v.y(), v.z()}); }
+
+void append_indent(std::string& out, std::size_t depth) { out.append(2 * depth, ' '); }
+
+/// One <volume> start tag on its own line, `depth` levels deep. Attribute order: type, name (if any), pos,
+/// then the type's own. It is closed at once (" />") unless children follow.
+void append_volume(std::string& out, const BoundingVolume& bv, std::string_view name, std::size_t depth, bool has_children) {
+    append_indent(out, depth);
+    out += "<volume type=\"";
+    out += to_string(type_of(bv));
+    out += '"';
+    if (!name.empty()) {
+        out += " name=\"";
+        append_escaped(out, name);
+        out += '"';
+    }
     std::visit(Overloaded{
                    [&](const Aabb& box) {
                        const Vec3 extents = box.max - box.min;
-                       set("pos", format_vector(box.center()));
-                       set("width", format_numbers({extents.x()}));
-                       set("depth", format_numbers({extents.y()}));
-                       set("height", format_numbers({extents.z()}));
+                       append_vector(out, "pos", box.center());
+                       append_numbers(out, "width", {extents.x()});
+                       append_numbers(out, "depth", {extents.y()});
+                       append_numbers(out, "height", {extents.z()});
                    },
                    [&](const Obb& box) {
                        const Vec3 extents = 2.0 * box.half_extents;
                        const Mat3& r = box.rotation;
-                       set("pos", format_vector(box.center));
-                       set("width", format_numbers({extents.x()}));
-                       set("depth", format_numbers({extents.y()}));
-                       set("height", format_numbers({extents.z()}));
-                       set("orientation", format_numbers({r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2),
-                                                          r(2, 0), r(2, 1), r(2, 2)}));
+                       append_vector(out, "pos", box.center);
+                       append_numbers(out, "width", {extents.x()});
+                       append_numbers(out, "depth", {extents.y()});
+                       append_numbers(out, "height", {extents.z()});
+                       append_numbers(out, "orientation",
+                                      {r(0, 0), r(0, 1), r(0, 2), r(1, 0), r(1, 1), r(1, 2), r(2, 0), r(2, 1), r(2, 2)});
                    },
                    [&](const Sphere& sphere) {
-                       set("pos", format_vector(sphere.center));
-                       set("radius", format_numbers({sphere.radius}));
+                       append_vector(out, "pos", sphere.center);
+                       append_numbers(out, "radius", {sphere.radius});
                    },
                    [&](const Capsule& capsule) {
-                       set("pos", format_vector(capsule.center()));
-                       set("direction", format_vector(capsule.direction()));
-                       set("length", format_numbers({capsule.length()}));
-                       set("radius", format_numbers({capsule.radius}));
+                       append_vector(out, "pos", capsule.center());
+                       append_vector(out, "direction", capsule.direction());
+                       append_numbers(out, "length", {capsule.length()});
+                       append_numbers(out, "radius", {capsule.radius});
                    },
                },
                bv);
+    out += has_children ? ">\n" : " />\n";
 }
 
-/// Collects pugixml's output in a string.
-class StringWriter final : public pugi::xml_writer {
-public:
-    void write(const void* data, std::size_t size) override { text.append(static_cast<const char*>(data), size); }
-    std::string text;
-};
-
-/// A document with its declaration and an empty <hierarchy>, ready to be filled.
-pugi::xml_node start_document(pugi::xml_document& doc) {
-    pugi::xml_node declaration = doc.append_child(pugi::node_declaration);
-    declaration.append_attribute("version").set_value("1.0");
-    declaration.append_attribute("encoding").set_value("UTF-8");
-    return doc.append_child("hierarchy");
+void append_end_tag(std::string& out, std::size_t depth) {
+    append_indent(out, depth);
+    out += "</volume>\n";
 }
 
-std::string save(const pugi::xml_document& doc) {
-    StringWriter writer;
-    doc.save(writer, "  ", pugi::format_indent, pugi::encoding_utf8);
-    return std::move(writer.text);
+/// The subtree under `root` as nested volumes, `depth` levels deep. Explicit stack: a degenerate
+/// (list-like) tree can be deeper than the call stack allows.
+void append_subtree(std::string& out, const Bvh& bvh, std::uint32_t root, std::size_t depth) {
+    struct Step {
+        std::uint32_t node;
+        std::size_t depth;
+        bool closes;  ///< The end tag of an inner node, after its children.
+    };
+    std::vector<Step> stack{{root, depth, false}};
+    while (!stack.empty()) {
+        const Step step = stack.back();
+        stack.pop_back();
+        if (step.closes) {
+            append_end_tag(out, step.depth);
+            continue;
+        }
+        const Node& node = bvh.nodes[step.node];
+        // Broken indices are a bug in whoever built the tree, not bad input.
+        HBVH_ASSERT(node.is_leaf() ? node.primitive < bvh.primitives.size()
+                                   : std::size_t{node.first_child} + node.child_count <= bvh.nodes.size());
+        if (node.is_leaf()) {
+            const Primitive& primitive = bvh.primitives[node.primitive];
+            append_volume(out, primitive.volume, primitive.name, step.depth, false);
+            continue;
+        }
+        append_volume(out, node.volume, {}, step.depth, true);
+        stack.push_back({step.node, step.depth, true});
+        // Pushed in reverse so that they pop, and are written, in child order.
+        for (std::uint32_t c = node.child_count; c-- > 0;) stack.push_back({node.first_child + c, step.depth + 1, false});
+    }
 }
+
+/// Appends the text of items [0, count) to `out`, `append_item(text, i)` writing item i. Many items are
+/// formatted in chunks on all cores (shortest-form numbers are most of the work) and joined in order, so
+/// the text is the same for any thread count.
+template <class AppendItem>
+void append_items(std::string& out, std::size_t count, std::size_t items_per_chunk, const AppendItem& append_item) {
+    const std::size_t chunk_count = (count + items_per_chunk - 1) / items_per_chunk;
+    if (chunk_count <= 1) {
+        for (std::size_t i = 0; i < count; ++i) append_item(out, i);
+        return;
+    }
+    std::vector<std::string> chunks(chunk_count);
+    tbb::parallel_for(std::size_t{0}, chunk_count, [&](std::size_t chunk) {
+        const std::size_t end = std::min(count, (chunk + 1) * items_per_chunk);
+        for (std::size_t i = chunk * items_per_chunk; i < end; ++i) append_item(chunks[chunk], i);
+    });
+    std::size_t size = out.size();
+    for (const std::string& chunk : chunks) size += chunk.size();
+    out.reserve(size + 64);  // room for the closing tags
+    for (std::string& chunk : chunks) {
+        out += chunk;
+        std::string().swap(chunk);
+    }
+}
+
+/// Primitives per formatting chunk: about a megabyte of text, enough to make a task worth starting.
+constexpr std::size_t primitives_per_chunk = 4096;
 
 }  // namespace
 
@@ -753,36 +840,36 @@ Result<XmlModel> read_xml_file(const std::filesystem::path& path) {
 }
 
 std::string write_xml(const Bvh& bvh) {
-    pugi::xml_document doc;
-    pugi::xml_node hierarchy = start_document(doc);
-    if (bvh.empty()) return save(doc);
-    // Explicit stack: a degenerate (list-like) tree can be deeper than the call stack allows.
-    std::vector<std::pair<std::uint32_t, pugi::xml_node>> stack{{0u, hierarchy}};
-    while (!stack.empty()) {
-        auto [index, parent] = stack.back();
-        stack.pop_back();
-        const Node& node = bvh.nodes[index];
-        // Broken indices are a bug in whoever built the tree, not bad input.
-        HBVH_ASSERT(node.is_leaf() ? node.primitive < bvh.primitives.size()
-                                   : std::size_t{node.first_child} + node.child_count <= bvh.nodes.size());
-        pugi::xml_node element = parent.append_child("volume");
-        if (node.is_leaf()) {
-            const Primitive& primitive = bvh.primitives[node.primitive];
-            write_volume(element, primitive.volume, primitive.name);
-            continue;
-        }
-        write_volume(element, node.volume, {});
-        // Pushed in reverse so that they pop, and are appended, in child order.
-        for (std::uint32_t c = node.child_count; c-- > 0;) stack.emplace_back(node.first_child + c, element);
+    std::string out(declaration);
+    if (bvh.empty()) return out + "<hierarchy />\n";
+    out += "<hierarchy>\n";
+    const Node& root = bvh.root();
+    if (root.is_leaf()) {
+        append_subtree(out, bvh, 0, 1);
+    } else {
+        // The root's subtrees are formatted side by side, in groups of consecutive children: enough groups
+        // to keep every core busy under a wide root, one subtree each under a binary one.
+        append_volume(out, root.volume, {}, 1, true);
+        const bool is_large = bvh.nodes.size() >= primitives_per_chunk;
+        const std::size_t per_group = is_large ? std::max<std::size_t>(1, root.child_count / 64) : root.child_count;
+        append_items(out, root.child_count, per_group, [&](std::string& text, std::size_t c) {
+            append_subtree(text, bvh, root.first_child + static_cast<std::uint32_t>(c), 2);
+        });
+        append_end_tag(out, 1);
     }
-    return save(doc);
+    out += "</hierarchy>\n";
+    return out;
 }
 
 std::string write_primitives_xml(std::span<const Primitive> primitives) {
-    pugi::xml_document doc;
-    pugi::xml_node hierarchy = start_document(doc);
-    for (const Primitive& primitive : primitives) write_volume(hierarchy.append_child("volume"), primitive.volume, primitive.name);
-    return save(doc);
+    std::string out(declaration);
+    if (primitives.empty()) return out + "<hierarchy />\n";
+    out += "<hierarchy>\n";
+    append_items(out, primitives.size(), primitives_per_chunk, [&](std::string& text, std::size_t i) {
+        append_volume(text, primitives[i].volume, primitives[i].name, 1, false);
+    });
+    out += "</hierarchy>\n";
+    return out;
 }
 
 }  // namespace hbvh

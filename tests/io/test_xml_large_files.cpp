@@ -6,6 +6,7 @@
 #include "hbvh/io/xml.hpp"
 
 #include <gtest/gtest.h>
+#include <pugixml.hpp>
 #include <tbb/task_arena.h>
 
 #include <cstdint>
@@ -177,6 +178,79 @@ TEST(XmlLargeFiles, TextInsideTheHierarchyIsReportedBeforeAnyVolume) {
     EXPECT_EQ(error.line, file.line_of_volume.back() + 1) << error.to_string();
     EXPECT_NE(error.message.find("unexpected text"), std::string::npos) << error.to_string();
     EXPECT_NE(error.message.find("stray"), std::string::npos) << error.to_string();
+}
+
+/// pugixml's own rendering of `text`: parsed (values decoded, nothing else changed) and saved the way the
+/// writer used to save its DOM. The writer no longer builds one; its text must still be exactly this.
+std::string pugixml_rendering(const std::string& text) {
+    pugi::xml_document document;
+    const pugi::xml_parse_result parsed =
+        document.load_buffer(text.data(), text.size(), pugi::parse_declaration | pugi::parse_escapes, pugi::encoding_utf8);
+    EXPECT_TRUE(parsed) << parsed.description();
+    struct Collect final : pugi::xml_writer {
+        void write(const void* data, std::size_t size) override { out.append(static_cast<const char*>(data), size); }
+        std::string out;
+    } collect;
+    document.save(collect, "  ", pugi::format_indent, pugi::encoding_utf8);
+    return collect.out;
+}
+
+TEST(XmlLargeFiles, WrittenTextIsWhatPugixmlWrites) {
+    // Every byte value in a name (the escaping of & < > " ' and control characters, and raw non-ASCII bytes).
+    std::vector<Primitive> primitives;
+    for (int byte = 1; byte < 256; ++byte) {
+        std::string name = "n";
+        name += static_cast<char>(byte);
+        name += 'e';
+        primitives.push_back({Sphere{Vec3(byte, 0, 0), 0.5}, name});
+    }
+    primitives.push_back({Aabb{Vec3(0, 0, 0), Vec3(1, 2, 3)}, ""});
+    primitives.push_back({Obb{Vec3(1, 2, 3), Mat3::Identity(), Vec3(0.5, 1e-300, 2e300)}, "box"});
+    primitives.push_back({Capsule{Vec3(0, 0, -1), Vec3(0, 0, 1), 0.25}, "barrel"});
+    const std::string flat = write_primitives_xml(primitives);
+    EXPECT_EQ(flat, pugixml_rendering(flat));
+    // Nested, wide (the root's children are formatted in groups) and deep.
+    TreeAssembler assembler(primitives);
+    std::vector<std::uint32_t> leaves;
+    for (std::uint32_t i = 0; i < primitives.size(); ++i) leaves.push_back(assembler.add_leaf(i));
+    const std::uint32_t inner = assembler.add_group(std::span(leaves).first(3), Sphere{Vec3(2, 0, 0), 3});
+    std::vector<std::uint32_t> top{inner};
+    top.insert(top.end(), leaves.begin() + 3, leaves.end());
+    const std::uint32_t root = assembler.add_group(top, Aabb{Vec3(-1, -1, -1), Vec3(300, 5, 5)});
+    const std::string nested = write_xml(std::move(assembler).finish(root));
+    EXPECT_EQ(nested, pugixml_rendering(nested));
+    EXPECT_EQ(write_xml(Bvh{}), pugixml_rendering(write_xml(Bvh{})));
+}
+
+TEST(XmlLargeFiles, LargeWrittenFilesAreWhatPugixmlWrites) {
+    // Above the size at which the writer formats chunks of volumes side by side.
+    std::vector<Primitive> primitives;
+    for (std::size_t i = 0; i < 20000; ++i)
+        primitives.push_back({Sphere{Vec3(static_cast<double>(i) * 0.1, 1.0 / static_cast<double>(i + 3), 0), 0.5},
+                              i % 3 == 0 ? "" : "p&" + std::to_string(i)});
+    const std::string flat = write_primitives_xml(primitives);
+    EXPECT_EQ(flat, pugixml_rendering(flat));
+    // A wide root: its children are formatted in groups side by side; and one subtree deeper.
+    TreeAssembler assembler(primitives);
+    std::vector<std::uint32_t> children;
+    for (std::uint32_t i = 0; i < primitives.size(); ++i) children.push_back(assembler.add_leaf(i));
+    const std::uint32_t pair = assembler.add_group(std::span(children).last(2), Sphere{Vec3(0, 0, 0), 1e4});
+    children.resize(children.size() - 2);
+    children.push_back(pair);
+    const std::string nested = write_xml(std::move(assembler).finish(assembler.add_group(children, Sphere{Vec3(0, 0, 0), 1e5})));
+    EXPECT_EQ(nested, pugixml_rendering(nested));
+    const Result<XmlModel> model = read_xml_string(flat, "large.xml");
+    ASSERT_TRUE(model) << model.error().to_string();
+    ASSERT_EQ(model->primitives.size(), primitives.size());
+    EXPECT_EQ(model->primitives[4].name, "p&4");
+}
+
+TEST(XmlLargeFiles, NamesEndAtANulAsPugixmlWroteThem) {
+    const std::vector<Primitive> primitives{{Sphere{Vec3(0, 0, 0), 1}, std::string("ab\0cd", 5)},
+                                            {Sphere{Vec3(1, 0, 0), 1}, std::string("\0x", 2)}};
+    const std::string text = write_primitives_xml(primitives);
+    EXPECT_NE(text.find("name=\"ab\" pos=\"0 0 0\""), std::string::npos) << text;
+    EXPECT_NE(text.find("name=\"\" pos=\"1 0 0\""), std::string::npos) << text;
 }
 
 }  // namespace
