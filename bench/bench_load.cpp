@@ -8,14 +8,28 @@
 //
 //   hbvh_bench --benchmark_filter='load_.*/20k'   (a split tree over 20 000 primitives, a second)
 //   hbvh_bench --benchmark_filter='load_.*/1M'    (a two-level tree over 10^6 primitives; the XML takes seconds)
+//
+// Reading and writing a large primitive set (docs/formats.md, "Reading and writing large XML"): the survey's flat
+// format, 10^6 primitives of `generate_scene` (about 230 MB, what `hbvh generate --count 1000000` writes). Rows, in
+// the order they run: pugixml_inplace, the anchor, pugixml's bare in-place parse of the file's text (a fresh copy
+// per iteration, outside the time; the DOM only, no conversion: what a harness built on pugixml pays at least);
+// read_xml_set, read_xml_file from disk (page cache) to the primitives; write_xml_set, write_primitives_xml and
+// write_file_atomic (with its fsync) to a file next to the input, with counters format_s and write_s for the parts.
+//
+//   hbvh_bench --benchmark_filter='xml_set|pugixml'   (about half a minute, most of it making the file)
 #include <benchmark/benchmark.h>
+// pugixml for the anchor row: linked through hbvh::io's static archive, which carries it as a link-only dependency.
+#include <pugixml.hpp>
 
 #include <unistd.h>
 
 #include <chrono>
 #include <filesystem>
+#include <iterator>
 #include <map>
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "hbvh/builders/build.hpp"
 #include "hbvh/io/file.hpp"
@@ -48,10 +62,7 @@ public:
     /// The files for `count` primitives, or an Error if building or writing failed.
     Result<StoredTree> get(std::uint32_t count) {
         if (const auto found = trees_.find(count); found != trees_.end()) return found->second;
-        if (dir_.empty()) {
-            dir_ = std::filesystem::temp_directory_path() / ("hbvh_bench_load_" + std::to_string(::getpid()));
-            std::filesystem::create_directories(dir_);
-        }
+        const std::filesystem::path& dir = directory();
         SceneOptions options;
         options.count = count;
         options.seed = 2024;
@@ -60,8 +71,8 @@ public:
         Result<Bvh> bvh = build(primitives, count <= 20'000 ? Algorithm::split : Algorithm::two_level);
         if (!bvh) return bvh.error();
         StoredTree tree;
-        tree.xml = dir_ / (std::to_string(count) + ".xml");
-        tree.binary = dir_ / (std::to_string(count) + ".hbvh");
+        tree.xml = dir / (std::to_string(count) + ".xml");
+        tree.binary = dir / (std::to_string(count) + ".hbvh");
         const std::string xml = write_xml(bvh.value());
         if (Status written = write_file_atomic(tree.xml, xml); !written) return written.error();
         if (Status written = write_binary_file(tree.binary, bvh.value()); !written) return written.error();
@@ -71,6 +82,15 @@ public:
         tree.binary_bytes = std::filesystem::file_size(tree.binary);
         trees_.emplace(count, tree);
         return tree;
+    }
+
+    /// The temporary directory, made on first use.
+    const std::filesystem::path& directory() {
+        if (dir_.empty()) {
+            dir_ = std::filesystem::temp_directory_path() / ("hbvh_bench_load_" + std::to_string(::getpid()));
+            std::filesystem::create_directories(dir_);
+        }
+        return dir_;
     }
 
 private:
@@ -129,10 +149,94 @@ void load_binary(benchmark::State& state, std::uint32_t count) {
         state.counters["speedup_vs_xml"] = xml->second / (seconds / static_cast<double>(state.iterations()));
 }
 
+/// The 10^6-primitive set on disk, written once per process into the same temporary directory.
+struct StoredSet {
+    std::filesystem::path xml;
+    std::vector<Primitive> primitives;
+    std::size_t xml_bytes = 0;
+};
+
+Result<const StoredSet*> stored_set() {
+    static std::optional<StoredSet> set;
+    if (set) return &*set;
+    SceneOptions options;
+    options.count = 1'000'000;
+    options.seed = 2024;
+    StoredSet made;
+    made.primitives = generate_scene(options);
+    made.xml = stored_trees().directory() / "set_1M.xml";
+    const std::string xml = write_primitives_xml(made.primitives);
+    if (Status written = write_file_atomic(made.xml, xml); !written) return written.error();
+    made.xml_bytes = xml.size();
+    set = std::move(made);
+    return &*set;
+}
+
+void pugixml_inplace(benchmark::State& state) {
+    const Result<const StoredSet*> set = stored_set();
+    if (!set) return fail(state, set.error().to_string());
+    const Result<std::string> text = read_text_file((*set)->xml);
+    if (!text) return fail(state, text.error().to_string());
+    std::string buffer;
+    std::size_t volumes = 0;
+    for (auto _ : state) {
+        buffer = *text;  // the parse writes into its buffer, so each iteration parses a fresh copy (untimed)
+        pugi::xml_document document;
+        const auto start = std::chrono::steady_clock::now();
+        const pugi::xml_parse_result parsed = document.load_buffer_inplace(buffer.data(), buffer.size());
+        state.SetIterationTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+        if (!parsed) return fail(state, parsed.description());
+        volumes = static_cast<std::size_t>(std::distance(document.first_child().begin(), document.first_child().end()));
+    }
+    // Children of <hierarchy> are the volumes and nothing else (the writer puts no text between them).
+    if (volumes != (*set)->primitives.size()) return fail(state, "pugixml did not find every volume");
+    state.counters["MB"] = static_cast<double>(text->size()) / 1e6;
+}
+
+void read_xml_set(benchmark::State& state) {
+    const Result<const StoredSet*> set = stored_set();
+    if (!set) return fail(state, set.error().to_string());
+    std::size_t primitives = 0;
+    benchmark::DoNotOptimize(read_xml_file((*set)->xml));  // untimed warm-up, as for the other rows
+    for (auto _ : state) {
+        Result<XmlModel> model = read_xml_file((*set)->xml);
+        primitives = model && !model->hierarchy ? model->primitives.size() : 0;
+        benchmark::DoNotOptimize(primitives);
+    }
+    if (primitives != (*set)->primitives.size()) return fail(state, "the XML file did not read back as the set written");
+    state.counters["MB"] = static_cast<double>((*set)->xml_bytes) / 1e6;
+}
+
+void write_xml_set(benchmark::State& state) {
+    const Result<const StoredSet*> set = stored_set();
+    if (!set) return fail(state, set.error().to_string());
+    const std::filesystem::path output = (*set)->xml.parent_path() / "set_1M_written.xml";
+    double format_seconds = 0.0;
+    double write_seconds = 0.0;
+    std::size_t bytes = 0;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        const std::string xml = write_primitives_xml((*set)->primitives);
+        const auto formatted = std::chrono::steady_clock::now();
+        if (Status written = write_file_atomic(output, xml); !written) return fail(state, written.error().to_string());
+        format_seconds += std::chrono::duration<double>(formatted - start).count();
+        write_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - formatted).count();
+        bytes = xml.size();
+    }
+    if (bytes != (*set)->xml_bytes) return fail(state, "the written text differs in size from the stored file");
+    const auto iterations = static_cast<double>(state.iterations());
+    state.counters["format_s"] = format_seconds / iterations;
+    state.counters["write_s"] = write_seconds / iterations;
+    state.counters["MB"] = static_cast<double>(bytes) / 1e6;
+}
+
 BENCHMARK_CAPTURE(load_xml, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK_CAPTURE(load_binary, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(20);
 BENCHMARK_CAPTURE(load_xml, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK_CAPTURE(load_binary, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK(pugixml_inplace)->Name("pugixml_inplace/1M")->Unit(benchmark::kMillisecond)->Iterations(3)->UseManualTime();
+BENCHMARK(read_xml_set)->Name("read_xml_set/1M")->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(write_xml_set)->Name("write_xml_set/1M")->Unit(benchmark::kMillisecond)->Iterations(2);
 
 }  // namespace
 }  // namespace hbvh::bench
