@@ -247,7 +247,7 @@ private:
     Result<Mat3> read_orientation(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
 
     std::string text_;      // parsed in place by doc_, so declared before it
-    std::string pristine_;  // an unparsed copy, kept only when the parse could move a text's first character
+    std::string pristine_;  // an unparsed copy, kept only when parse_can_rewrite_white_space(text)
     LineTable lines_;       // of the text before parsing
     std::string source_;
     pugi::xml_document doc_;
@@ -823,8 +823,8 @@ void append_items(std::string& out, std::size_t count, std::size_t items_per_chu
     }
 }
 
-/// Primitives per formatting chunk: about a megabyte of text, enough to make a task worth starting.
-constexpr std::size_t primitives_per_chunk = 4096;
+/// Volumes per formatting chunk: about a megabyte of text, enough to make a task worth starting.
+constexpr std::size_t volumes_per_chunk = 4096;
 
 }  // namespace
 
@@ -850,7 +850,7 @@ std::string write_xml(const Bvh& bvh) {
         // The root's subtrees are formatted side by side, in groups of consecutive children: enough groups
         // to keep every core busy under a wide root, one subtree each under a binary one.
         append_volume(out, root.volume, {}, 1, true);
-        const bool is_large = bvh.nodes.size() >= primitives_per_chunk;
+        const bool is_large = bvh.nodes.size() >= volumes_per_chunk;
         const std::size_t per_group = is_large ? std::max<std::size_t>(1, root.child_count / 64) : root.child_count;
         append_items(out, root.child_count, per_group, [&](std::string& text, std::size_t c) {
             append_subtree(text, bvh, root.first_child + static_cast<std::uint32_t>(c), 2);
@@ -865,7 +865,7 @@ std::string write_primitives_xml(std::span<const Primitive> primitives) {
     std::string out(declaration);
     if (primitives.empty()) return out + "<hierarchy />\n";
     out += "<hierarchy>\n";
-    append_items(out, primitives.size(), primitives_per_chunk, [&](std::string& text, std::size_t i) {
+    append_items(out, primitives.size(), volumes_per_chunk, [&](std::string& text, std::size_t i) {
         append_volume(text, primitives[i].volume, primitives[i].name, 1, false);
     });
     out += "</hierarchy>\n";
