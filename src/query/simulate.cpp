@@ -3,7 +3,9 @@
 // whose roots overlap so that every measured query really descends the hierarchy.
 #include "hbvh/query/simulate.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <limits>
 
 #include "hbvh/assert.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -38,14 +40,20 @@ struct Accumulator {
     }
 };
 
-/// One timed query; only the query call is inside the clock.
-double timed_query(const QueryTree& tree, const RigidTransform& pose_a, const RigidTransform& pose_b,
-                   const SimulateOptions& options, CollideResult& result) {
-    const auto start = std::chrono::steady_clock::now();
+/// One query of the simulator's method and mode.
+void run_query(const QueryTree& tree, const RigidTransform& pose_a, const RigidTransform& pose_b,
+               const SimulateOptions& options, CollideResult& result) {
     if (options.method == QueryMethod::tandem)
         collide(tree, pose_a, tree, pose_b, options.mode, result);
     else
         collide_two_level(tree, pose_a, tree, pose_b, options.mode, result);
+}
+
+/// One timed query; only the query call is inside the clock.
+double timed_query(const QueryTree& tree, const RigidTransform& pose_a, const RigidTransform& pose_b,
+                   const SimulateOptions& options, CollideResult& result) {
+    const auto start = std::chrono::steady_clock::now();
+    run_query(tree, pose_a, pose_b, options, result);
     const auto stop = std::chrono::steady_clock::now();
     return std::chrono::duration<double>(stop - start).count();
 }
@@ -92,7 +100,10 @@ SimulationResult simulate(const Bvh& object, const SimulateOptions& options) {
         const RigidTransform pose_b = placed(rotation, next, center);
         const double elapsed = timed_query(tree, pose_a, pose_b, options, result);
         // The root test is always the first test, and only a pair of overlapping roots gets visited.
-        if (result.nodes_visited > 0) moving.add(result, elapsed);
+        if (result.nodes_visited > 0) {
+            moving.add(result, elapsed);
+            if (options.record_poses) out.moving_poses.push_back(pose_b);
+        }
         if (!result.intersecting) {
             position = next;
             blocked = 0;
@@ -125,9 +136,29 @@ SimulationResult simulate(const Bvh& object, const SimulateOptions& options) {
         const RigidTransform pose = placed(rng.rotation(), center, center);
         const double elapsed = timed_query(tree, pose, pose, options, result);
         total.add(result, elapsed);
+        if (options.record_poses) out.total_poses.push_back(pose);
     }
     out.total = total.stats();
     return out;
+}
+
+double time_queries(const QueryTree& tree, std::span<const RigidTransform> poses, SimulatedPhase phase,
+                    QueryMethod method, CollideMode mode, int passes) {
+    HBVH_ASSERT(!poses.empty() && passes >= 1);
+    const SimulateOptions options{.method = method, .mode = mode};
+    const RigidTransform identity = RigidTransform::identity();
+    CollideResult result;
+    double fastest = std::numeric_limits<double>::infinity();
+    for (int pass = 0; pass < passes; ++pass) {
+        const auto start = std::chrono::steady_clock::now();
+        for (const RigidTransform& pose : poses) {
+            const RigidTransform& pose_a = phase == SimulatedPhase::moving ? identity : pose;
+            run_query(tree, pose_a, pose, options, result);
+        }
+        const auto stop = std::chrono::steady_clock::now();
+        fastest = std::min(fastest, std::chrono::duration<double>(stop - start).count());
+    }
+    return fastest / static_cast<double>(poses.size());
 }
 
 }  // namespace hbvh

@@ -4,6 +4,8 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
+#include <vector>
 
 #include "hbvh/query/tandem_traversal.hpp"
 
@@ -23,6 +25,9 @@ struct SimulateOptions {
     CollideMode mode = CollideMode::first;  ///< `first` answers "do they collide", as a simulator asks.
     double step = 0.05;                    ///< Distance moved per step, as a fraction of the object's radius.
     std::uint64_t max_steps = 2'000'000;   ///< Gives up (complete = false) after this many steps.
+    /// Keep the measured queries' poses (SimulationResult::moving_poses, total_poses), so that other trees
+    /// over the same primitives can be timed on exactly these queries (time_queries).
+    bool record_poses = false;
 };
 
 /// Averages over a set of timed queries.
@@ -44,6 +49,10 @@ struct SimulationResult {
     std::uint64_t steps = 0;     ///< Simulation steps taken (queries run, measured or not).
     std::uint32_t restarts = 0;  ///< Times the mover was re-launched (left the scene or got stuck).
     bool complete = false;       ///< False when max_steps ran out before collision_count samples.
+    /// With record_poses: copy B's pose in each measured moving query (copy A rests at the identity).
+    std::vector<RigidTransform> moving_poses;
+    /// With record_poses: the shared pose of both copies in each totally colliding query.
+    std::vector<RigidTransform> total_poses;
 };
 
 /// Runs the simulator on two copies of `object` (non-empty). Copy A rests at the identity pose. Copy B,
@@ -54,5 +63,18 @@ struct SimulationResult {
 /// new seeded start when it gets 3 radii away, slows below 1% of its speed, or stays blocked 20 steps.
 /// Frames: the object's model frame; its radius is half the diagonal of its primitives' AABB.
 [[nodiscard]] SimulationResult simulate(const Bvh& object, const SimulateOptions& options = {});
+
+/// Which of the simulator's query sets time_queries replays.
+enum class SimulatedPhase : std::uint8_t {
+    moving,  ///< Copy A at the identity, copy B at each pose.
+    total,   ///< Both copies at each pose.
+};
+
+/// Mean seconds per query of `method` on two copies of `tree` over `poses` (as recorded by simulate for
+/// `phase`): the fastest of `passes` passes, each timed as a whole. Unlike simulate's own per-query clock,
+/// this is fit to rank trees: every tree answers the same queries, no clock call sits inside a query, and
+/// the fastest pass drops what other processes cost. Precondition: poses non-empty, passes >= 1.
+[[nodiscard]] double time_queries(const QueryTree& tree, std::span<const RigidTransform> poses, SimulatedPhase phase,
+                                  QueryMethod method, CollideMode mode, int passes);
 
 }  // namespace hbvh
