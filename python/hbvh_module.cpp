@@ -433,7 +433,7 @@ py::dict stats_dict(const Hierarchy& h) {
                                    "primitive"_a = v.primitive, "name"_a = h.bvh.primitives[v.primitive].name,
                                    "by"_a = v.protrusion, "message"_a = describe(h.bvh, v)));
     py::dict out;
-    out["cost"] = stats.cost, out["height"] = stats.height, out["nodes"] = stats.nodes;
+    out["cost"] = stats.cost, out["calibrated_cost"] = stats.calibrated_cost, out["height"] = stats.height, out["nodes"] = stats.nodes;
     out["inner_nodes"] = stats.inner_nodes, out["leaves"] = stats.leaves;
     out["branching"] = summary_dict(stats.branching), out["tightness"] = summary_dict(stats.tightness);
     out["leaf_depth"] = summary_dict(stats.leaf_depth), out["overlap"] = stats.overlap, out["types"] = types;

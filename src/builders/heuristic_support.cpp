@@ -134,8 +134,9 @@ double PrimitiveSet::estimate(std::span<const std::uint32_t> locals) const {
 
 namespace {
 
-// Box around the spheres in the frame `rotation` (columns = axes): its volume.
-double box_volume_in(std::span<const Sphere> spheres, const Mat3& rotation) {
+// Box around the spheres in the frame `rotation` (columns = axes), given in that frame: its volume and the
+// calibrated measure are those of the OBB, both being invariant under rotation.
+Aabb box_in(std::span<const Sphere> spheres, const Mat3& rotation) {
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
     Vec3 hi = -lo;
     for (const Sphere& s : spheres) {
@@ -143,12 +144,12 @@ double box_volume_in(std::span<const Sphere> spheres, const Mat3& rotation) {
         lo = lo.cwiseMin(local - Vec3::Constant(s.radius));
         hi = hi.cwiseMax(local + Vec3::Constant(s.radius));
     }
-    return (hi - lo).prod();
+    return {lo, hi};
 }
 
 // Capsule on the line through `origin` along unit `axis`: the radius covers every sphere's distance from
-// the line, the segment spans the centres' projections, so every sphere is inside. Its volume.
-double capsule_volume_on(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
+// the line, the segment spans the centres' projections, so every sphere is inside.
+Capsule capsule_around_line(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
     double radius = 0.0, t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
     for (const Sphere& s : spheres) {
         const Vec3 d = s.center - origin;
@@ -157,7 +158,7 @@ double capsule_volume_on(std::span<const Sphere> spheres, const Vec3& origin, co
         t_min = std::min(t_min, t);
         t_max = std::max(t_max, t);
     }
-    return Capsule{origin + t_min * axis, origin + t_max * axis, radius}.volume();
+    return Capsule{origin + t_min * axis, origin + t_max * axis, radius};
 }
 
 }  // namespace
@@ -166,9 +167,11 @@ double estimate_weighted_volume(std::span<const Sphere> spheres, std::span<const
                                 const VolumePolicy& policy) {
     HBVH_ASSERT(!spheres.empty());
     double best = std::numeric_limits<double>::infinity();
+    // Candidates are measured as the policy measures a node (volume, or the calibrated objective's measure).
+    const auto measure = [&](const BoundingVolume& candidate) { return policy.unweighted_measure(candidate); };
     const auto consider = [&](BvType type, double v) { best = std::min(best, policy.weight_of(type) * v); };
-    if (policy.is_allowed(BvType::aabb)) consider(BvType::aabb, fit_aabb(spheres).volume());
-    if (policy.is_allowed(BvType::sphere)) consider(BvType::sphere, fit_sphere(spheres).volume());
+    if (policy.is_allowed(BvType::aabb)) consider(BvType::aabb, measure(fit_aabb(spheres)));
+    if (policy.is_allowed(BvType::sphere)) consider(BvType::sphere, measure(fit_sphere(spheres)));
     if (!policy.is_allowed(BvType::obb) && !policy.is_allowed(BvType::capsule)) return best;
 
     // Principal axes of the centres (weighted equally), as Gottschalk's covariance fit but without a hull.
@@ -180,16 +183,16 @@ double estimate_weighted_volume(std::span<const Sphere> spheres, std::span<const
     const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);
     const Mat3 principal = eigen.eigenvectors();  // columns ascending by eigenvalue; last = main axis
     if (policy.is_allowed(BvType::obb)) {
-        double v = std::min(box_volume_in(spheres, Mat3::Identity()), box_volume_in(spheres, principal));
+        double v = std::min(measure(box_in(spheres, Mat3::Identity())), measure(box_in(spheres, principal)));
         for (const BoundingVolume& hint : hints)
-            if (const Obb* box = std::get_if<Obb>(&hint)) v = std::min(v, box_volume_in(spheres, box->rotation));
+            if (const Obb* box = std::get_if<Obb>(&hint)) v = std::min(v, measure(box_in(spheres, box->rotation)));
         consider(BvType::obb, v);
     }
     if (policy.is_allowed(BvType::capsule)) {
-        double v = capsule_volume_on(spheres, mean, principal.col(2));
+        double v = measure(capsule_around_line(spheres, mean, principal.col(2)));
         for (const BoundingVolume& hint : hints)
             if (const Capsule* capsule = std::get_if<Capsule>(&hint))
-                v = std::min(v, capsule_volume_on(spheres, capsule->center(), capsule->direction()));
+                v = std::min(v, measure(capsule_around_line(spheres, capsule->center(), capsule->direction())));
         consider(BvType::capsule, v);
     }
     return best;

@@ -47,15 +47,18 @@ public:
 
     // Smallest weighted volume among the allowed kinds.
     [[nodiscard]] double weighted_volume() const {
+        // Each candidate is measured as the policy measures a node (volume, or the calibrated objective's
+        // measure); both are rotation-invariant, so the box in the frame stands for the OBB and a capsule along
+        // z for the one along the frame's main axis.
         double best = std::numeric_limits<double>::infinity();
-        const auto consider = [&](BvType type, double v) {
-            if (policy_.is_allowed(type)) best = std::min(best, policy_.weight_of(type) * v);
+        const auto consider = [&](BvType type, const BoundingVolume& candidate) {
+            if (!policy_.is_allowed(type)) return;
+            best = std::min(best, policy_.weight_of(type) * policy_.unweighted_measure(candidate));
         };
-        consider(BvType::aabb, box_.volume());
-        consider(BvType::obb, frame_box_.volume());
-        consider(BvType::sphere, sphere_.volume());
-        const double r = capsule_radius_;
-        consider(BvType::capsule, std::numbers::pi * r * r * (t_max_ - t_min_) + 4.0 / 3.0 * std::numbers::pi * r * r * r);
+        consider(BvType::aabb, box_);
+        consider(BvType::obb, frame_box_);
+        consider(BvType::sphere, sphere_);
+        consider(BvType::capsule, Capsule{Vec3(0, 0, t_min_), Vec3(0, 0, t_max_), capsule_radius_});
         return best;
     }
 

@@ -114,7 +114,10 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
     std::vector<Mat3> bound_planes{Mat3::Identity()};
     for (BvType type : all_bv_types) {
         if (!policy.is_allowed(type)) continue;
-        if (type == BvType::capsule && best && capsule_cannot_win(*context, bound_planes, policy, best_cost)) continue;
+        // The bound is on a capsule's volume, so it can only skip the fit when volume is the measure.
+        if (type == BvType::capsule && best && policy.measure == NodeMeasure::volume &&
+            capsule_cannot_win(*context, bound_planes, policy, best_cost))
+            continue;
         BoundingVolume candidate = [&]() -> BoundingVolume {
             switch (type) {
                 case BvType::aabb: return fit_aabb(spheres);

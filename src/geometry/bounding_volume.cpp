@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/geometry/bounding_volume.hpp"
 
+#include <numbers>
 #include <type_traits>
 
 namespace hbvh {
@@ -19,6 +20,39 @@ std::optional<BvType> parse_bv_type(std::string_view name) {
 double volume(const BoundingVolume& bv) {
     return std::visit([](const auto& v) { return v.volume(); }, bv);
 }
+
+namespace {
+/// Surface area and mean width of a box with full edges `e`.
+double box_area(const Vec3& e) { return 2.0 * (e.x() * e.y() + e.y() * e.z() + e.z() * e.x()); }
+double box_mean_width(const Vec3& e) { return 0.5 * e.sum(); }
+}  // namespace
+
+double surface_area(const BoundingVolume& bv) {
+    return std::visit(Overloaded{
+                          [](const Aabb& box) { return box_area(box.max - box.min); },
+                          [](const Obb& box) { return box_area(2.0 * box.half_extents); },
+                          [](const Sphere& s) { return 4.0 * std::numbers::pi * s.radius * s.radius; },
+                          [](const Capsule& c) {
+                              return 2.0 * std::numbers::pi * c.radius * c.length() +
+                                     4.0 * std::numbers::pi * c.radius * c.radius;
+                          },
+                      },
+                      bv);
+}
+
+double mean_width(const BoundingVolume& bv) {
+    // Mean width adds under Minkowski sums, and a segment of length L has mean width L/2: a capsule
+    // (segment + ball) has 2r + L/2.
+    return std::visit(Overloaded{
+                          [](const Aabb& box) { return box_mean_width(box.max - box.min); },
+                          [](const Obb& box) { return box_mean_width(2.0 * box.half_extents); },
+                          [](const Sphere& s) { return 2.0 * s.radius; },
+                          [](const Capsule& c) { return 2.0 * c.radius + 0.5 * c.length(); },
+                      },
+                      bv);
+}
+
+double self_minkowski_volume(const BoundingVolume& bv) { return 2.0 * volume(bv) + surface_area(bv) * mean_width(bv); }
 
 BoundingVolume transformed(const BoundingVolume& bv, const RigidTransform& t) {
     return std::visit(Overloaded{

@@ -45,6 +45,9 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
     Stats stats;
     stats.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
     stats.cost = cost(bvh, policy);
+    VolumePolicy calibrated = policy;
+    calibrated.measure = NodeMeasure::minkowski;
+    stats.calibrated_cost = cost(bvh, calibrated);
     SummaryBuilder branching, tightness, leaf_depth;
     double overlap_volume = 0.0, sibling_volume = 0.0;
 

@@ -8,7 +8,7 @@ import pytest
 import hbvh
 from conftest import MODELS, built, run_cli
 
-STATS_KEYS = ["cost", "height", "nodes", "inner_nodes", "leaves", "branching", "tightness", "leaf_depth", "overlap",
+STATS_KEYS = ["cost", "calibrated_cost", "height", "nodes", "inner_nodes", "leaves", "branching", "tightness", "leaf_depth", "overlap",
               "types", "violations"]
 
 

@@ -69,6 +69,7 @@ struct BuilderFlags {
     std::string algorithm = "auto";
     std::string types = "aabb,obb,sphere,capsule";
     std::string type_weights;
+    std::string objective = "eq2";  ///< --objective: eq2 (the survey's volume) or calibrated (Minkowski measure).
     double time_limit_seconds = 0.0;  ///< --time-limit: anytime builders return the best found by then.
     bool refine = false;              ///< --refine: treelet refinement after any builder.
     std::uint32_t treelet_units = TreeletOptions{}.max_units;  ///< --treelet-units.

@@ -124,6 +124,11 @@ void BuilderFlags::add_to(CLI::App& command) {
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
                        "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each)");
+    command.add_option("--objective", objective,
+                       "Cost the builder minimises: eq2 (Eq. 2, node volume) or calibrated (node "
+                       "measured by its Minkowski sum with a turned copy; docs/metrics.md)")
+        ->capture_default_str()
+        ->check(CLI::IsMember({"eq2", "calibrated"}));
     command.add_option("--time-limit", time_limit_seconds,
                        "Seconds the build may take (0 = no limit); scale and bnb-exact return their best by then")
         ->check(CLI::NonNegativeNumber);
@@ -144,6 +149,7 @@ Result<BuildRequest> BuilderFlags::resolve() const {
         policy = parse_type_weights(type_weights, policy.value());
         if (!policy) return policy.error();
     }
+    if (objective == "calibrated") policy->measure = NodeMeasure::minkowski;
     BuildRequest request;
     request.algorithm = *chosen;
     request.context.policy = policy.value();

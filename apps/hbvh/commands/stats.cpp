@@ -24,6 +24,7 @@ nlohmann::ordered_json to_json(const Stats& stats) {
     nlohmann::ordered_json types;
     for (BvType type : all_bv_types) types[std::string(to_string(type))] = stats.types[static_cast<std::size_t>(type)];
     return {{"cost", stats.cost},
+            {"calibrated_cost", stats.calibrated_cost},
             {"height", stats.height},
             {"nodes", stats.nodes},
             {"inner_nodes", stats.inner_nodes},
@@ -40,6 +41,7 @@ void print_text(const Stats& stats) {
         fmt::print("{:<12} min {:.4g}  mean {:.4g}  max {:.4g}\n", name, s.min, s.mean, s.max);
     };
     fmt::print("{:<12} {:.6g}\n", "cost", stats.cost);
+    fmt::print("{:<12} {:.6g}\n", "calibrated", stats.calibrated_cost);
     fmt::print("{:<12} {}\n", "height", stats.height);
     fmt::print("{:<12} {} ({} inner, {} leaves)\n", "nodes", stats.nodes, stats.inner_nodes, stats.leaves);
     line("branching", stats.branching);

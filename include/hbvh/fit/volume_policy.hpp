@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string_view>
 
 #include "hbvh/geometry/bounding_volume.hpp"
@@ -10,17 +11,30 @@
 
 namespace hbvh {
 
-/// The BV kinds a hierarchy may use for inner nodes, with a weight per kind.
-/// A weighted volume (weight x volume) is what fit_best minimises and what the cost sums: the survey's
-/// §6.1 idea of charging complex BVs for their slower overlap tests. All weights default to 1.
+/// How a node's size enters the cost.
+enum class NodeMeasure : std::uint8_t {
+    volume,     ///< The survey's Eq. 2: the BV's volume.
+    minkowski,  ///< self_minkowski_volume: the calibrated objective's measure (docs/metrics.md).
+};
+
+/// The BV kinds a hierarchy may use for inner nodes, with a weight per kind and the measure of a node.
+/// A weighted measure (weight x volume, by default) is what fit_best minimises and what the cost sums: the
+/// survey's §6.1 idea of charging complex BVs for their slower overlap tests. All weights default to 1.
 struct VolumePolicy {
     std::array<bool, bv_type_count> allowed{true, true, true, true};
     std::array<double, bv_type_count> weight{1.0, 1.0, 1.0, 1.0};
+    NodeMeasure measure = NodeMeasure::volume;
 
     [[nodiscard]] bool is_allowed(BvType type) const { return allowed[static_cast<std::size_t>(type)]; }
     [[nodiscard]] double weight_of(BvType type) const { return weight[static_cast<std::size_t>(type)]; }
-    /// weight(type of bv) x volume(bv).
-    [[nodiscard]] double weighted_volume(const BoundingVolume& bv) const { return weight_of(type_of(bv)) * volume(bv); }
+    /// The measure of bv (its volume unless `measure` says otherwise), without the kind's weight.
+    [[nodiscard]] double unweighted_measure(const BoundingVolume& bv) const {
+        return measure == NodeMeasure::volume ? volume(bv) : self_minkowski_volume(bv);
+    }
+    /// weight(type of bv) x the measure of bv.
+    [[nodiscard]] double weighted_volume(const BoundingVolume& bv) const {
+        return weight_of(type_of(bv)) * unweighted_measure(bv);
+    }
 
     /// Every kind allowed, weight 1.
     [[nodiscard]] static VolumePolicy all() { return {}; }

@@ -42,6 +42,16 @@ inline constexpr std::array<BvType, bv_type_count> all_bv_types{BvType::aabb, Bv
 
 /// Volume of the solid (cubic units).
 [[nodiscard]] double volume(const BoundingVolume& bv);
+/// Area of the solid's surface (square units).
+[[nodiscard]] double surface_area(const BoundingVolume& bv);
+/// The solid's width averaged over all directions (its extent along a random axis): for a box (a+b+c)/2
+/// with full edges a, b, c; for a sphere its diameter; for a capsule 2r + L/2.
+[[nodiscard]] double mean_width(const BoundingVolume& bv);
+/// The volume of the Minkowski sum of the solid with a copy of itself turned at random, averaged over the
+/// turns: 2V + S w (the mixed-volume terms of the sum average to S w / 2 each; a ball of radius r gives
+/// the ball of radius 2r). It is what the chance that two similar nodes meet grows with, and unlike V it
+/// does not vanish for a flat box (docs/metrics.md, "Calibrated cost").
+[[nodiscard]] double self_minkowski_volume(const BoundingVolume& bv);
 /// The BV moved rigidly. An Aabb under a rotation becomes an Obb, so the result is exact.
 [[nodiscard]] BoundingVolume transformed(const BoundingVolume& bv, const RigidTransform& t);
 /// True when every point of `s` lies in `bv`, allowing `tolerance` (absolute length).

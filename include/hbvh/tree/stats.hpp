@@ -19,6 +19,9 @@ struct Summary {
 
 struct Stats {
     double cost = 0.0;               ///< Eq. 2: sum over inner nodes of child_count x (weighted) volume.
+    /// The same sum with each node measured by self_minkowski_volume instead (the calibrated objective,
+    /// docs/metrics.md), with the policy's weights.
+    double calibrated_cost = 0.0;
     std::uint32_t height = 0;        ///< Edges on the longest root-to-leaf path (a lone leaf: 0).
     std::uint32_t nodes = 0;
     std::uint32_t inner_nodes = 0;
@@ -30,7 +33,7 @@ struct Stats {
     std::array<std::uint32_t, bv_type_count> types{};  ///< Node count per BV kind (all nodes).
 };
 
-/// Eq. 2 with the policy's per-kind weights (weights 1 give the survey's cost).
+/// Eq. 2 with the policy's per-kind weights and node measure (weights 1 and volume give the survey's cost).
 [[nodiscard]] double cost(const Bvh& bvh, const VolumePolicy& policy = {});
 [[nodiscard]] Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy = {});
 
