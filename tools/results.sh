@@ -29,7 +29,7 @@ wanted() { [[ -z $only || ",$only," == *",$1,"* ]]; }
 # Build: Release, only the targets used here. hbvh_peers exists only when Bullet (float64) and FCL are found.
 log "configuring $build (Release)"
 cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >"$work/cmake.log" 2>&1 || { cat "$work/cmake.log" >&2; exit 1; }
-targets=(hbvh_cli hbvh_bench)
+targets=(hbvh_cli hbvh_bench hbvh_objectives)
 have_peers=0
 if [[ $(cmake --build "$build" --target help 2>/dev/null) == *hbvh_peers* ]]; then
     targets+=(hbvh_peers)
@@ -306,6 +306,21 @@ def bench_table(path, prefix, *counters):
         cells = [f'{v[c]:.6g}' if c in v else '' for c in counters]
         print(f'| {name} | {v["real_time"]:.4g} {v["time_unit"]} | ' + ' | '.join(cells) + ' |')
 
+def objectives_summary(path):
+    rows = markdown_rows(path)
+    def column(key): return [(r['object'], number(r[key])) for r in rows if number(r[key]) is not None]
+    for key in ['ρ Eq. 2 / moving', 'ρ calibrated / moving', 'ρ Eq. 2 / total', 'ρ calibrated / total']:
+        values = column(key)
+        if not values: continue
+        worst = min(values, key=lambda v: v[1])
+        above = sum(1 for _, v in values if v >= 0.8)
+        print(f"- {key}: median {statistics.median(v for _, v in values):+.2f}, worst {worst[1]:+.2f} ({worst[0]}), "
+              f"at least 0.8 on {above} of {len(values)} objects.")
+    ratios = [v for _, v in column('auto/cal ÷ auto, moving')]
+    if ratios:
+        print(f"- `auto` built for the calibrated objective against `auto` for Eq. 2, moving phase: time ratio "
+              f"{min(ratios):.2f}-{max(ratios):.2f}, median {statistics.median(ratios):.2f}.")
+
 globals()[sys.argv[1]](*sys.argv[2:])
 PYTHON
 
@@ -499,6 +514,27 @@ if wanted 6; then
     else
         emit "_Skipped: hbvh_peers was not configured (Bullet float64 or FCL not found)._" ""
     fi
+fi
+
+# ---------------------------------------------------------------------------------------------------------
+# 7. Which cost predicts query time.
+if wanted 7; then
+    emit "## 7. Which cost predicts query time" ""
+    log "section 7: hbvh_objectives (10-15 min)"
+    emit "Every registered builder's tree of each object, built for Eq. 2 and for the calibrated objective" \
+         "(\`NAME/cal\`, docs/metrics.md \"Calibrated cost\"), timed on the same 300 recorded queries of the" \
+         "survey's simulator per phase (\`first\` mode; the mover's path recorded once with the Two-Level query, so" \
+         "that it depends on no tree; fastest of 7 passes, each timed as a whole). ρ is Spearman's rank" \
+         "correlation between a cost and the measured time over all the object's trees (1: the cost orders the" \
+         "trees exactly as their speed). The last two columns: time of \`auto\` built for the calibrated" \
+         "objective over \`auto\` built for Eq. 2. The survey's searches (\`bnb-*\`, \`optimal\`) run up to 100" \
+         "primitives and 5 s per build." ""
+    command_block "build/bench/hbvh_objectives --markdown --summary --collisions 300 --build-seconds 5"
+    "$build/bench/hbvh_objectives" --markdown --summary --collisions 300 --build-seconds 5 >"$work/objectives.md" \
+        2>"$work/objectives.err" || emit "_hbvh_objectives exited non-zero: $(tail -1 "$work/objectives.err")_"
+    cat "$work/objectives.md" >>"$doc"
+    emit "" "**What it shows.**"
+    summarise objectives_summary "$work/objectives.md"
 fi
 
 emit "---" "" "tools/results.sh took $(($(date +%s) - measure_start)) s of measurement on this run (after a" \

@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdlib>
-#include <filesystem>
 #include <optional>
 #include <type_traits>
 #include <string>
@@ -15,11 +14,10 @@
 
 #include "hbvh/builders/build.hpp"
 #include "hbvh/geometry/overlap.hpp"
-#include "hbvh/io/import.hpp"
-#include "hbvh/io/xml.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
+#include "../common/bench_objects.hpp"
 #include "peer.hpp"
 
 namespace hbvh::peers {
@@ -60,10 +58,7 @@ double median(std::vector<double> values) {
     return values.empty() ? 0.0 : values[values.size() / 2];
 }
 
-struct Object {
-    std::string name;
-    std::vector<Primitive> primitives;
-};
+using Object = bench::BenchObject;
 
 enum class Regime { partial, near, total };
 constexpr std::string_view regime_name(Regime regime) {
@@ -129,42 +124,6 @@ Algorithm pick_algorithm() {
     for (std::string_view name : {"auto", "bnb-enlarge", "two-level"})
         if (auto algorithm = parse_algorithm(name)) return *algorithm;
     return algorithms().front().algorithm;
-}
-
-std::vector<Object> load_objects() {
-    std::vector<Object> objects;
-    std::vector<std::filesystem::path> files;
-    for (const auto& entry : std::filesystem::directory_iterator(HBVH_SOURCE_DIR "/data/models"))
-        if (entry.path().extension() == ".xml") files.push_back(entry.path());
-    std::sort(files.begin(), files.end());
-    for (const auto& file : files) {
-        Result<XmlModel> model = read_xml_file(file);
-        if (!model) {
-            fmt::print(stderr, "hbvh_peers: skipping {}\n", model.error().to_string());
-            continue;
-        }
-        objects.push_back({file.stem().string(), std::move(model->primitives)});
-    }
-    // The robots of ../shared/data (real MJCF and URDF models made by others), when that folder is beside the
-    // checkout; their mesh geoms are skipped by the importers, their primitives kept.
-    const std::filesystem::path shared = HBVH_SOURCE_DIR "/../shared/data/models";
-    std::vector<std::filesystem::path> robots;
-    if (std::filesystem::is_directory(shared))
-        for (const auto& entry : std::filesystem::directory_iterator(shared))
-            if (entry.path().extension() == ".xml" || entry.path().extension() == ".urdf") robots.push_back(entry.path());
-    std::sort(robots.begin(), robots.end());
-    for (const auto& file : robots) {
-        Result<ImportResult> imported = import_primitives(file.string());
-        if (!imported || imported->primitives.size() < 2) {
-            fmt::print(stderr, "hbvh_peers: skipping {}\n", imported ? file.string() + ": fewer than 2 primitives"
-                                                                      : imported.error().to_string());
-            continue;
-        }
-        objects.push_back({file.stem().string(), std::move(imported->primitives)});
-    }
-    for (std::uint32_t count : {13u, 27u, 100u, 1000u})
-        objects.push_back({fmt::format("generated-{}", count), generate_scene({.count = count, .seed = 2024})});
-    return objects;
 }
 
 /// Fixed seeded poses of copy b for one regime. partial: random rotation and offset with the root BVs
@@ -404,7 +363,7 @@ int main(int argc, char** argv) {
     std::vector<Row> rows;
     std::vector<BuildRow> builds;
     fmt::print(stderr, "hbvh_peers: builder {}\n", hbvh::to_string(pick_algorithm()));
-    for (const Object& object : load_objects())
+    for (const Object& object : hbvh::bench::load_bench_objects("hbvh_peers"))
         if (object.name.find(options.only) != std::string::npos) run_object(object, options, rows, builds);
     print(builds, rows, options);
     // A disagreement beyond the tolerance means one of the three is wrong: fail, so that scripts notice.

@@ -1,0 +1,260 @@
+// SPDX-License-Identifier: MIT
+// hbvh_objectives: does a tree's cost predict how fast it answers queries? For every object, every
+// registered builder's tree is timed on the same simulator queries (the survey's §5.3 benchmark, both
+// phases), and each cost objective is scored by its Spearman rank correlation with the measured times.
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <numeric>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "../common/bench_objects.hpp"
+#include "hbvh/builders/build.hpp"
+#include "hbvh/query/simulate.hpp"
+#include "hbvh/tree/stats.hpp"
+
+namespace hbvh::bench {
+namespace {
+
+struct Options {
+    bool markdown = false;
+    std::uint32_t collisions = 300;  ///< Root-overlapping queries per phase.
+    int passes = 7;                  ///< Timed passes over the queries; the fastest counts.
+    double build_seconds = 10.0;     ///< A builder that needs longer on an object gets no row for it.
+    std::string only;                ///< When set, only objects whose name contains it.
+    bool verbose = false;            ///< Each build's time on stderr.
+    CollideMode mode = CollideMode::first;  ///< The simulator's: does B touch A at all.
+    bool summary_only = false;              ///< Only the table of correlations, not every tree's row.
+};
+
+/// One builder's tree on one object.
+struct Row {
+    std::string builder;
+    double eq2 = 0.0;
+    double calibrated = 0.0;
+    double moving_us = 0.0;
+    double total_us = 0.0;
+};
+
+/// Ranks 1..n with ties given their mean rank, as Spearman's coefficient needs.
+std::vector<double> ranks(const std::vector<double>& values) {
+    std::vector<std::size_t> order(values.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return values[a] < values[b]; });
+    std::vector<double> rank(values.size());
+    for (std::size_t i = 0; i < order.size();) {
+        std::size_t j = i;
+        while (j + 1 < order.size() && values[order[j + 1]] == values[order[i]]) ++j;
+        const double mean_rank = 0.5 * static_cast<double>(i + j) + 1.0;
+        for (std::size_t k = i; k <= j; ++k) rank[order[k]] = mean_rank;
+        i = j + 1;
+    }
+    return rank;
+}
+
+/// Spearman's rank correlation: Pearson's on the ranks. nullopt when either side has no spread.
+std::optional<double> spearman(const std::vector<double>& x, const std::vector<double>& y) {
+    const std::vector<double> rx = ranks(x), ry = ranks(y);
+    const double n = static_cast<double>(rx.size());
+    const double mx = std::accumulate(rx.begin(), rx.end(), 0.0) / n;
+    const double my = std::accumulate(ry.begin(), ry.end(), 0.0) / n;
+    double sxy = 0.0, sxx = 0.0, syy = 0.0;
+    for (std::size_t i = 0; i < rx.size(); ++i) {
+        sxy += (rx[i] - mx) * (ry[i] - my);
+        sxx += (rx[i] - mx) * (rx[i] - mx);
+        syy += (ry[i] - my) * (ry[i] - my);
+    }
+    if (sxx == 0.0 || syy == 0.0) return std::nullopt;
+    return sxy / std::sqrt(sxx * syy);
+}
+
+std::string format_rho(const std::optional<double>& rho) { return rho ? fmt::format("{:+.2f}", *rho) : "-"; }
+
+/// The simulator's queries for `object`, recorded from a run with the Two-Level query: its first reported
+/// pair, and so the mover's path, depends on the primitives alone, not on any tree.
+SimulationResult record_queries(const std::vector<Primitive>& primitives, const Options& options) {
+    Result<Bvh> two_level = build(primitives, Algorithm::two_level);
+    SimulateOptions simulate_options{.collision_count = options.collisions, .seed = 3,
+                                     .method = QueryMethod::two_level, .record_poses = true};
+    return simulate(two_level.value(), simulate_options);
+}
+
+/// The smallest object size on which each builder ran out of build time: it is not tried on larger ones,
+/// whose deadline it would miss too (and some builders overrun theirs by far on large inputs).
+using SizeLimits = std::map<std::string_view, std::size_t>;
+
+/// The two objectives a builder can minimise (BuildContext::policy.measure).
+constexpr std::array<NodeMeasure, 2> objectives{NodeMeasure::volume, NodeMeasure::minkowski};
+
+/// The row of one tree: its costs under both objectives (`calibrated`: the policy measuring nodes by
+/// self_minkowski_volume, docs/metrics.md) and its time on the recorded queries.
+Row measure_tree(std::string builder, const Bvh& bvh, const SimulationResult& queries, const Options& options,
+                 const VolumePolicy& calibrated) {
+    const QueryTree tree(bvh);
+    Row row{.builder = std::move(builder), .eq2 = cost(bvh), .calibrated = cost(bvh, calibrated)};
+    row.moving_us = 1e6 * time_queries(tree, queries.moving_poses, SimulatedPhase::moving, QueryMethod::tandem,
+                                       options.mode, options.passes);
+    row.total_us = 1e6 * time_queries(tree, queries.total_poses, SimulatedPhase::total, QueryMethod::tandem,
+                                      options.mode, options.passes);
+    return row;
+}
+
+/// Every builder's tree under each objective ("NAME" for Eq. 2, "NAME/cal" for the calibrated one).
+std::vector<Row> measure_object(const BenchObject& object, const Options& options, const VolumePolicy& calibrated,
+                                SizeLimits& too_slow_from) {
+    const SimulationResult queries = record_queries(object.primitives, options);
+    std::vector<Row> rows;
+    if (queries.moving_poses.empty()) return rows;
+    for (const AlgorithmInfo& info : algorithms()) {
+        // The survey's searches fit candidates before their deadline applies: beyond 100 primitives they can
+        // run for many minutes whatever the budget (docs/algorithms.md).
+        const bool is_search = info.name.starts_with("bnb-") || info.name == "optimal";
+        if (is_search && object.primitives.size() > 100) continue;
+        if (auto limit = too_slow_from.find(info.name);
+            limit != too_slow_from.end() && object.primitives.size() >= limit->second) {
+            fmt::print(stderr, "hbvh_objectives: {}: no {} row (out of build time on {} primitives)\n", object.name,
+                       info.name, limit->second);
+            continue;
+        }
+        for (NodeMeasure objective : objectives) {
+            const std::string name = std::string(info.name) + (objective == NodeMeasure::volume ? "" : "/cal");
+            BuildReport report;
+            BuildContext context = BuildContext{}.with_time_limit(options.build_seconds);
+            context.policy.measure = objective;
+            context.report = &report;
+            const auto started = std::chrono::steady_clock::now();
+            Result<Bvh> bvh = info.build(object.primitives, context);
+            if (options.verbose)
+                fmt::print(stderr, "hbvh_objectives: {}: {} built in {:.2f} s\n", object.name, name,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count());
+            if (bvh && report.budget_hit) too_slow_from.emplace(info.name, object.primitives.size());
+            if (!bvh || report.budget_hit) {
+                fmt::print(stderr, "hbvh_objectives: {}: no {} row ({})\n", object.name, name,
+                           bvh ? "build budget reached" : bvh.error().to_string());
+                break;
+            }
+            rows.push_back(measure_tree(name, *bvh, queries, options, calibrated));
+        }
+    }
+    return rows;
+}
+
+/// One object's summary: how each cost ranks its trees, and what building auto for the calibrated
+/// objective changed in query time.
+struct Correlations {
+    std::size_t trees = 0;
+    std::optional<double> eq2_moving, eq2_total, calibrated_moving, calibrated_total;
+    std::optional<double> auto_moving_ratio, auto_total_ratio;  ///< auto/cal time / auto time.
+};
+
+Correlations correlate(const std::vector<Row>& rows) {
+    std::vector<double> eq2, calibrated, moving, total;
+    const Row* by_eq2 = nullptr;
+    const Row* by_calibrated = nullptr;
+    for (const Row& row : rows) {
+        eq2.push_back(row.eq2);
+        calibrated.push_back(row.calibrated);
+        moving.push_back(row.moving_us);
+        total.push_back(row.total_us);
+        if (row.builder == "auto") by_eq2 = &row;
+        if (row.builder == "auto/cal") by_calibrated = &row;
+    }
+    Correlations c;
+    c.trees = rows.size();
+    c.eq2_moving = spearman(eq2, moving);
+    c.eq2_total = spearman(eq2, total);
+    c.calibrated_moving = spearman(calibrated, moving);
+    c.calibrated_total = spearman(calibrated, total);
+    if (by_eq2 && by_calibrated) {
+        c.auto_moving_ratio = by_calibrated->moving_us / by_eq2->moving_us;
+        c.auto_total_ratio = by_calibrated->total_us / by_eq2->total_us;
+    }
+    return c;
+}
+
+void print_object(const BenchObject& object, const std::vector<Row>& rows, const Options& options) {
+    if (options.markdown) {
+        fmt::print("\n#### {} ({} primitives)\n\n", object.name, object.primitives.size());
+        fmt::print("| builder | Eq. 2 cost | calibrated cost | moving µs | total µs |\n|---|---:|---:|---:|---:|\n");
+        for (const Row& r : rows)
+            fmt::print("| {} | {:.6g} | {:.6g} | {:.3f} | {:.3f} |\n", r.builder, r.eq2, r.calibrated, r.moving_us, r.total_us);
+        return;
+    }
+    fmt::print("\n{} ({} primitives)\n{:<16} {:>14} {:>16} {:>10} {:>10}\n", object.name, object.primitives.size(),
+               "builder", "Eq. 2 cost", "calibrated cost", "moving us", "total us");
+    for (const Row& r : rows)
+        fmt::print("{:<16} {:>14.6g} {:>16.6g} {:>10.3f} {:>10.3f}\n", r.builder, r.eq2, r.calibrated, r.moving_us, r.total_us);
+}
+
+std::string format_ratio(const std::optional<double>& ratio) { return ratio ? fmt::format("{:.2f}", *ratio) : "-"; }
+
+void print_summary(const std::vector<std::pair<std::string, Correlations>>& summary, const Options& options) {
+    if (options.markdown) {
+        fmt::print("\n| object | trees | ρ Eq. 2 / moving | ρ Eq. 2 / total | ρ calibrated / moving | "
+                   "ρ calibrated / total | auto/cal ÷ auto, moving | auto/cal ÷ auto, total |\n"
+                   "|---|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (const auto& [name, c] : summary)
+            fmt::print("| {} | {} | {} | {} | {} | {} | {} | {} |\n", name, c.trees, format_rho(c.eq2_moving),
+                       format_rho(c.eq2_total), format_rho(c.calibrated_moving), format_rho(c.calibrated_total),
+                       format_ratio(c.auto_moving_ratio), format_ratio(c.auto_total_ratio));
+        return;
+    }
+    fmt::print("\n{:<36} {:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", "Spearman rho", "trees", "eq2/mov",
+               "eq2/total", "cal/mov", "cal/total", "autocal/m", "autocal/t");
+    for (const auto& [name, c] : summary)
+        fmt::print("{:<36} {:>5} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", name, c.trees, format_rho(c.eq2_moving),
+                   format_rho(c.eq2_total), format_rho(c.calibrated_moving), format_rho(c.calibrated_total),
+                   format_ratio(c.auto_moving_ratio), format_ratio(c.auto_total_ratio));
+}
+
+}  // namespace
+}  // namespace hbvh::bench
+
+int main(int argc, char** argv) {
+    using namespace hbvh::bench;
+    Options options;
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        if (arg == "--markdown") {
+            options.markdown = true;
+        } else if (arg == "--collisions" && i + 1 < argc) {
+            options.collisions = static_cast<std::uint32_t>(std::strtoul(argv[++i], nullptr, 10));
+        } else if (arg == "--passes" && i + 1 < argc) {
+            options.passes = std::max(1, std::atoi(argv[++i]));
+        } else if (arg == "--build-seconds" && i + 1 < argc) {
+            options.build_seconds = std::strtod(argv[++i], nullptr);
+        } else if (arg == "--summary") {
+            options.summary_only = true;
+        } else if (arg == "--all-pairs") {
+            options.mode = hbvh::CollideMode::all;
+        } else if (arg == "--verbose") {
+            options.verbose = true;
+        } else if (arg == "--only" && i + 1 < argc) {
+            options.only = argv[++i];
+        } else {
+            fmt::print(stderr, "usage: hbvh_objectives [--markdown] [--collisions N] [--passes N] [--build-seconds S] "
+                               "[--only NAME] [--verbose] [--all-pairs] [--summary]\n");
+            return 2;
+        }
+    }
+    hbvh::VolumePolicy calibrated = hbvh::VolumePolicy::all();
+    calibrated.measure = hbvh::NodeMeasure::minkowski;
+    std::vector<std::pair<std::string, Correlations>> summary;
+    SizeLimits too_slow_from;
+    for (const BenchObject& object : load_bench_objects("hbvh_objectives")) {
+        if (object.name.find(options.only) == std::string::npos) continue;
+        const std::vector<Row> rows = measure_object(object, options, calibrated, too_slow_from);
+        if (!options.summary_only) print_object(object, rows, options);
+        summary.emplace_back(object.name, correlate(rows));
+    }
+    print_summary(summary, options);
+    return 0;
+}
