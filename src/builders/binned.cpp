@@ -136,6 +136,7 @@ public:
         depth_limit_ = static_cast<std::uint32_t>(2.0 * std::log2(static_cast<double>(set.size()) + 1.0)) + 32;
         const VolumePolicy& policy = set.policy();
         box_weight_ = policy.is_allowed(BvType::aabb) ? policy.weight_of(BvType::aabb) : 1.0;
+        measure_ = policy.measure;
         needs_moments_ = policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule);
     }
 
@@ -311,9 +312,15 @@ private:
     /// Cuts are priced by the sides' world boxes whatever kinds are allowed: pricing OBBs and capsules in the
     /// range's principal frame as well (as split does) gave no cheaper trees in the end (the kept nodes' own
     /// fits decide their kinds) and cost 15 % of the build at 10^6 primitives (docs/scale.md §9).
-    [[nodiscard]] static CutCost cut_cost(double left_count, const Aabb& left, double right_count, const Aabb& right) {
+    [[nodiscard]] CutCost cut_cost(double left_count, const Aabb& left, double right_count, const Aabb& right) const {
         const double wl = side_weight(left_count), wr = side_weight(right_count);
-        return {wl * left.volume() + wr * right.volume(), wl * box_area(left) + wr * box_area(right)};
+        return {wl * box_measure(left) + wr * box_measure(right), wl * box_area(left) + wr * box_area(right)};
+    }
+
+    /// A box as the policy measures a node: its volume, or under the calibrated objective its
+    /// self_minkowski_volume (the volume path stays a plain product: it runs for every bin of every cut).
+    [[nodiscard]] double box_measure(const Aabb& box) const {
+        return measure_ == NodeMeasure::volume ? box.volume() : self_minkowski_volume(box);
     }
 
     /// The median along the centres' longest extent (ties by local index): balanced whatever the input.
@@ -356,7 +363,7 @@ private:
                 const double cost = left[i] + right[k - i];
                 if (cost < best[k]) best[k] = cost, split[k] = static_cast<std::uint8_t>(i);
             }
-        const double volume = box_weight_ * node.box.volume();
+        const double volume = box_weight_ * box_measure(node.box);
         double kept = infinity;
         std::uint8_t children = 2;
         for (std::uint32_t k = 2; k <= m; ++k) {
@@ -556,6 +563,7 @@ private:
     std::uint32_t max_children_;
     std::uint32_t depth_limit_ = 0;
     double box_weight_ = 1.0;
+    NodeMeasure measure_ = NodeMeasure::volume;
     bool needs_moments_ = false;               ///< Whether OBBs or capsules are fitted (they need a frame).
     std::vector<std::uint32_t> pieces_;        ///< The kept nodes' children, as slots, node after node.
     std::vector<Moments> moments_;             ///< Per kept node (as `wide`), when needs_moments_.
