@@ -400,15 +400,18 @@ void save(const Hierarchy& h, const std::string& path) {
 // Stage 4: building, measuring, querying.
 
 Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& algorithm, const std::string& types,
-                          double time_limit, bool refine) {
+                          double time_limit, bool refine, const std::string& objective) {
     const Primitives primitives = joined(primitives_in);
     const std::optional<Algorithm> chosen = parse_algorithm(algorithm);
     if (!chosen) raise(Error{"unknown algorithm '" + algorithm + "' (see `hbvh algorithms`)"});
     Result<VolumePolicy> policy = parse_allowed_types(types);
     if (!policy) raise(policy.error());
     if (!(time_limit >= 0.0)) throw py::value_error("time_limit must be a number of seconds >= 0 (0: no limit)");
+    if (objective != "eq2" && objective != "calibrated")
+        throw py::value_error("objective must be 'eq2' or 'calibrated', not '" + objective + "'");
     BuildContext context;
     context.policy = policy.value();
+    if (objective == "calibrated") context.policy.measure = NodeMeasure::minkowski;
     std::optional<Result<Bvh>> built;
     {
         py::gil_scoped_release unlocked;
@@ -541,8 +544,9 @@ PYBIND11_MODULE(hbvh, m) {
           "one, else Primitives. format as the CLI's --format. A stored hierarchy whose volumes miss primitives is "
           "refused, or with refit=True repaired.");
     m.def("build", &build_hierarchy, "primitives"_a, "algorithm"_a = "auto", "types"_a = "aabb,obb,sphere,capsule",
-          "time_limit"_a = 0.0, "refine"_a = false,
-          "Builds a Hierarchy over Primitives (or a list of them) with a registered builder (see algorithms()).");
+          "time_limit"_a = 0.0, "refine"_a = false, "objective"_a = "eq2",
+          "Builds a Hierarchy over Primitives (or a list of them) with a registered builder (see algorithms()). "
+          "objective as the CLI's --objective: 'eq2' (the survey's Eq. 2) or 'calibrated'.");
     m.def("algorithms", [] {
         std::vector<std::string> names;
         for (const hbvh::AlgorithmInfo& info : hbvh::algorithms()) names.emplace_back(info.name);
