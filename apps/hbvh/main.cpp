@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
     add_simulate_command(app, command);
     add_export_command(app, command);
     add_view_command(app, command);
+    add_calibrate_command(app, command);
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

@@ -126,3 +126,13 @@ hbvh_cli_bad_pose(zero_quaternion --pose-b "1 0 0 0 0 0 0" ": the quaternion is 
 add_test(NAME cli.collide
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
                  -DWORK=${HBVH_CLI_OUT}/collide -P ${CMAKE_CURRENT_LIST_DIR}/collide.cmake)
+
+# hbvh calibrate writes per-kind weights that --type-weight @FILE reads back; a missing file is named (exit 2,
+# as for any bad flag).
+hbvh_cli_test(calibrate 0 "" calibrate --primitives 40 --queries 20 --passes 1 -o ${HBVH_CLI_OUT}/weights.txt)
+hbvh_cli_test(type_weight_file 0 "" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a split
+              --type-weight @${HBVH_CLI_OUT}/weights.txt -o ${HBVH_CLI_OUT}/weighted_chair.xml)
+set_tests_properties(cli.calibrate PROPERTIES FIXTURES_SETUP calibrated_weights)
+set_tests_properties(cli.type_weight_file PROPERTIES FIXTURES_REQUIRED calibrated_weights)
+hbvh_cli_test(type_weight_file_missing 2 "no-such-weights.txt" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              --type-weight @${HBVH_CLI_OUT}/no-such-weights.txt -o ${HBVH_CLI_OUT}/unweighted_chair.xml)

@@ -34,6 +34,7 @@ void add_collide_command(CLI::App& app, Command& command);
 void add_simulate_command(CLI::App& app, Command& command);
 void add_export_command(CLI::App& app, Command& command);
 void add_view_command(CLI::App& app, Command& command);
+void add_calibrate_command(CLI::App& app, Command& command);
 
 /// A loaded input: always the primitives; the hierarchy too when the file nests volumes.
 struct Model {

@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <iostream>
 #include <iterator>
@@ -123,7 +124,7 @@ void BuilderFlags::add_to(CLI::App& command) {
         ->capture_default_str();
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
-                       "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each)");
+                       "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each), or @FILE as `hbvh calibrate` writes");
     command.add_option("--objective", objective,
                        "Cost the builder minimises: eq2 (Eq. 2, node volume) or calibrated (node "
                        "measured by its Minkowski sum with a turned copy; docs/metrics.md)")
@@ -146,7 +147,15 @@ Result<BuildRequest> BuilderFlags::resolve() const {
     Result<VolumePolicy> policy = parse_allowed_types(types);
     if (!policy) return policy.error();
     if (!type_weights.empty()) {
-        policy = parse_type_weights(type_weights, policy.value());
+        // "@FILE": the weights `hbvh calibrate -o FILE` wrote, in the same type=weight syntax.
+        std::string list = type_weights;
+        if (list.starts_with('@')) {
+            Result<std::string> text = read_text_file(list.substr(1));
+            if (!text) return text.error();
+            list = *text;
+            while (!list.empty() && std::isspace(static_cast<unsigned char>(list.back()))) list.pop_back();
+        }
+        policy = parse_type_weights(list, policy.value());
         if (!policy) return policy.error();
     }
     if (objective == "calibrated") policy->measure = NodeMeasure::minkowski;
