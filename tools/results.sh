@@ -522,16 +522,23 @@ if wanted 7; then
     emit "## 7. Which cost predicts query time" ""
     log "section 7: hbvh_objectives (10-15 min)"
     emit "Every registered builder's tree of each object, built for Eq. 2 and for the calibrated objective" \
-         "(\`NAME/cal\`, docs/metrics.md \"Calibrated cost\"), timed on the same 300 recorded queries of the" \
+         "(\`NAME/cal\`: Minkowski measure and measured per-kind weights, docs/metrics.md \"Calibrated cost\"), timed on the same 300 recorded queries of the" \
          "survey's simulator per phase (\`first\` mode; the mover's path recorded once with the Two-Level query, so" \
          "that it depends on no tree; fastest of 7 passes, each timed as a whole). ρ is Spearman's rank" \
          "correlation between a cost and the measured time over all the object's trees (1: the cost orders the" \
          "trees exactly as their speed). The last two columns: time of \`auto\` built for the calibrated" \
          "objective over \`auto\` built for Eq. 2. The survey's searches (\`bnb-*\`, \`optimal\`) run up to 100" \
          "primitives and 5 s per build." ""
-    command_block "build/bench/hbvh_objectives --markdown --summary --collisions 300 --build-seconds 5"
-    "$build/bench/hbvh_objectives" --markdown --summary --collisions 300 --build-seconds 5 >"$work/objectives.md" \
-        2>"$work/objectives.err" || emit "_hbvh_objectives exited non-zero: $(tail -1 "$work/objectives.err")_"
+    emit "The calibrated objective's per-kind weights are measured first, on this machine, by \`hbvh calibrate\`" \
+         "(each kind's inner-node test cost in the tandem traversal, relative to an AABB's):" ""
+    emit '```' "$hbvh calibrate -o weights.txt" \
+        "build/bench/hbvh_objectives --markdown --summary --collisions 300 --build-seconds 5 --type-weight \"\$(cat weights.txt)\"" \
+        '```' ''
+    "$hbvh" calibrate -o "$work/weights.txt" >"$work/calibrate.txt"
+    emit '```' "$(grep -v '^weights written' "$work/calibrate.txt")" '```' ''
+    "$build/bench/hbvh_objectives" --markdown --summary --collisions 300 --build-seconds 5 \
+        --type-weight "$(cat "$work/weights.txt")" >"$work/objectives.md" 2>"$work/objectives.err" ||
+        emit "_hbvh_objectives exited non-zero: $(tail -1 "$work/objectives.err")_"
     cat "$work/objectives.md" >>"$doc"
     emit "" "**What it shows.**"
     summarise objectives_summary "$work/objectives.md"

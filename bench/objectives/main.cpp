@@ -33,6 +33,7 @@ struct Options {
     bool verbose = false;            ///< Each build's time on stderr.
     CollideMode mode = CollideMode::first;  ///< The simulator's: does B touch A at all.
     bool summary_only = false;              ///< Only the table of correlations, not every tree's row.
+    std::string type_weights;               ///< Per-kind weights of the calibrated objective (hbvh calibrate's).
 };
 
 /// One builder's tree on one object.
@@ -128,7 +129,7 @@ std::vector<Row> measure_object(const BenchObject& object, const Options& option
             const std::string name = std::string(info.name) + (objective == NodeMeasure::volume ? "" : "/cal");
             BuildReport report;
             BuildContext context = BuildContext{}.with_time_limit(options.build_seconds);
-            context.policy.measure = objective;
+            if (objective == NodeMeasure::minkowski) context.policy = calibrated;
             context.report = &report;
             const auto started = std::chrono::steady_clock::now();
             Result<Bvh> bvh = info.build(object.primitives, context);
@@ -231,6 +232,8 @@ int main(int argc, char** argv) {
             options.passes = std::max(1, std::atoi(argv[++i]));
         } else if (arg == "--build-seconds" && i + 1 < argc) {
             options.build_seconds = std::strtod(argv[++i], nullptr);
+        } else if (arg == "--type-weight" && i + 1 < argc) {
+            options.type_weights = argv[++i];
         } else if (arg == "--summary") {
             options.summary_only = true;
         } else if (arg == "--all-pairs") {
@@ -241,17 +244,22 @@ int main(int argc, char** argv) {
             options.only = argv[++i];
         } else {
             fmt::print(stderr, "usage: hbvh_objectives [--markdown] [--collisions N] [--passes N] [--build-seconds S] "
-                               "[--only NAME] [--verbose] [--all-pairs] [--summary]\n");
+                               "[--only NAME] [--verbose] [--all-pairs] [--summary] [--type-weight LIST]\n");
             return 2;
         }
     }
-    hbvh::VolumePolicy calibrated = hbvh::VolumePolicy::all();
-    calibrated.measure = hbvh::NodeMeasure::minkowski;
+    hbvh::Result<hbvh::VolumePolicy> calibrated =
+        options.type_weights.empty() ? hbvh::VolumePolicy::all() : hbvh::parse_type_weights(options.type_weights);
+    if (!calibrated) {
+        fmt::print(stderr, "hbvh_objectives: --type-weight: {}\n", calibrated.error().to_string());
+        return 2;
+    }
+    calibrated->measure = hbvh::NodeMeasure::minkowski;
     std::vector<std::pair<std::string, Correlations>> summary;
     SizeLimits too_slow_from;
     for (const BenchObject& object : load_bench_objects("hbvh_objectives")) {
         if (object.name.find(options.only) == std::string::npos) continue;
-        const std::vector<Row> rows = measure_object(object, options, calibrated, too_slow_from);
+        const std::vector<Row> rows = measure_object(object, options, *calibrated, too_slow_from);
         if (!options.summary_only) print_object(object, rows, options);
         summary.emplace_back(object.name, correlate(rows));
     }
