@@ -8,7 +8,10 @@
 // with t_leaf from the Two-Level query (primitive tests only) on the same queries; each kind's t_kind follows.
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <array>
+#include <span>
+#include <utility>
 
 #include "commands/command.hpp"
 #include "hbvh/builders/build.hpp"
