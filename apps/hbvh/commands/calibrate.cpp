@@ -78,7 +78,10 @@ int run_calibrate(const CalibrateArguments& args) {
     fmt::print("{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
     for (BvType type : all_bv_types) {
         const double ns = 1e9 * inner_seconds[static_cast<std::size_t>(type)];
-        const double weight = aabb > 0.0 && ns > 0.0 ? inner_seconds[static_cast<std::size_t>(type)] / aabb : 1.0;
+        // A kind whose share could not be told from the noise (0 after the leaf tests) keeps weight 1; the floor
+        // keeps every weight one that --type-weight accepts (positive at the printed precision).
+        const double weight =
+            aabb > 0.0 && ns > 0.0 ? std::max(inner_seconds[static_cast<std::size_t>(type)] / aabb, 0.001) : 1.0;
         fmt::print("{:<8} {:>12.2f} {:>8.3f}\n", to_string(type), ns, weight);
         weights += fmt::format("{}{}={:.3f}", weights.empty() ? "" : ",", to_string(type), weight);
     }
