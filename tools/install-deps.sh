@@ -4,7 +4,7 @@
 # what is missing, and refreshes the package lists only when something is.
 set -euo pipefail
 packages=(
-  cmake ninja-build g++ pkg-config python3
+  cmake ninja-build g++ pkg-config python3 ccache
   libeigen3-dev libpugixml-dev libcli11-dev nlohmann-json3-dev libfmt-dev
   libcgal-dev libqhull-dev libtbb-dev libnanoflann-dev
   libgtest-dev libgmock-dev libbenchmark-dev libccd-dev
