@@ -6,6 +6,7 @@
 
 #include "guarded_build.hpp"
 #include "report_text.hpp"
+#include "treelet_fit_cache.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/tree/stats.hpp"
 
@@ -30,6 +31,9 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     const bool limited = context.has_deadline();
     std::string skipped;
     std::size_t done = 0;
+    // The members' trees are over the same primitives and refined under the same policy, and their
+    // treelets cover many of the same sets: one cache fits each set once for all of them.
+    detail::TreeletFitCache fits(primitives.size());
     for (Algorithm member : members) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
@@ -49,7 +53,8 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         costs += std::string(to_string(member)) + " " + detail::format_cost(member_cost);
         TreeletReport treelets;
         if (refine_each) {
-            tree = refine_treelets(tree, context.policy, treelets_within(context, options.treelets), &treelets);
+            tree = detail::refine_treelets_cached(tree, context.policy, treelets_within(context, options.treelets), fits,
+                                                  &treelets);
             member_cost = treelets.cost_after;
             costs += " -> " + detail::format_cost(member_cost);
         }
@@ -63,7 +68,8 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         context.report_progress(static_cast<double>(++done) / static_cast<double>(members.size() + 1));
     }
     if (refine_any && !refine_each)
-        *best = refine_treelets(*best, context.policy, treelets_within(context, options.treelets), &best_treelets);
+        *best = detail::refine_treelets_cached(*best, context.policy, treelets_within(context, options.treelets), fits,
+                                               &best_treelets);
     if (context.report != nullptr) {
         *context.report = std::move(best_report);
         if (members.size() > 1)

@@ -22,6 +22,7 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/builders/optimal.hpp"
 #include "optimal_plan.hpp"
+#include "treelet_fit_cache.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/tree/stats.hpp"
 
@@ -37,29 +38,13 @@ struct Item {
     std::uint32_t primitive = 0;
 };
 
-/// fit_best over one covered set and its weighted volume.
-struct Fitted {
-    BoundingVolume volume;
-    double weighted = 0.0;
-};
-
-/// FNV-1a over the sorted primitive indices of a covered set.
-struct CoveredHash {
-    std::size_t operator()(const std::vector<std::uint32_t>& key) const {
-        std::uint64_t h = 1469598103934665603ull;
-        for (std::uint32_t v : key) {
-            h ^= v;
-            h *= 1099511628211ull;
-        }
-        return static_cast<std::size_t>(h);
-    }
-};
+using Fitted = detail::TreeletFit;
 
 class Refiner {
 public:
-    Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options)
+    Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
         : primitives_(bvh.primitives), policy_(policy),
-          max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)) {
+          max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits) {
         items_.reserve(bvh.nodes.size());
         for (const Node& node : bvh.nodes) {
             Item item{node.volume, {}, node.primitive};
@@ -111,7 +96,7 @@ private:
     const VolumePolicy& policy_;
     std::uint32_t max_units_;
     std::vector<Item> items_;
-    std::unordered_map<std::vector<std::uint32_t>, Fitted, CoveredHash> cache_;
+    std::unordered_map<std::vector<std::uint32_t>, Fitted, detail::CoveredSetHash>& cache_;
     std::uint64_t fits_ = 0;
 };
 
@@ -156,7 +141,8 @@ bool Refiner::refine_at(std::uint32_t root) {
     }
 
     // Stage 3: fit_best over the primitives of every union of two or more units. Covered sets recur
-    // across treelets and passes, so fits are cached by set; the missing ones are fitted in parallel,
+    // across treelets, passes and (through a shared cache) refinements of other trees over the same
+    // primitives, so fits are cached by set; the missing ones are fitted in parallel,
     // each depending on its set only, so the result does not depend on the thread count.
     std::vector<std::vector<std::uint32_t>> unit_primitives(units);
     for (std::uint32_t i = 0; i < units; ++i) unit_primitives[i] = covered(frontier[i]);
@@ -258,6 +244,13 @@ Bvh Refiner::finish() const {
 
 Bvh refine_treelets(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options,
                     TreeletReport* report) {
+    detail::TreeletFitCache cache(bvh.primitives.size());
+    return detail::refine_treelets_cached(bvh, policy, options, cache, report);
+}
+
+Bvh detail::refine_treelets_cached(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options,
+                                   TreeletFitCache& cache, TreeletReport* report) {
+    HBVH_ASSERT(cache.primitive_count() == bvh.primitives.size());
     const auto start = Clock::now();
     TreeletReport local;
     if (bvh.nodes.size() < 2) {
@@ -265,7 +258,7 @@ Bvh refine_treelets(const Bvh& bvh, const VolumePolicy& policy, const TreeletOpt
         return bvh;
     }
     local.cost_before = cost(bvh, policy);
-    Refiner refiner(bvh, policy, options);
+    Refiner refiner(bvh, policy, options, cache);
     for (std::uint32_t pass = 0; pass < options.max_passes && !local.time_limit_hit; ++pass) {
         bool changed = false;
         for (std::uint32_t id : refiner.inner_postorder()) {

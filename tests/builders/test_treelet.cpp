@@ -15,6 +15,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "builders/treelet_fit_cache.hpp"
 #include "support/bundled_models.hpp"
 #include "support/test_helpers.hpp"
 #include "support/tree_properties.hpp"
@@ -122,6 +123,29 @@ TEST(Treelet, SameTreeForAnyThreadCount) {
         EXPECT_EQ(volume(one.nodes[i].volume), volume(two.nodes[i].volume)) << i;
     }
     EXPECT_EQ(cost(one), cost(two));
+}
+
+// auto refines every member's tree with one fit cache. A cached fit must be exactly the fit a fresh
+// refinement would make: each member refined after the others through the shared cache gives the tree
+// it gives alone, and the later refinements find fits the earlier ones made.
+TEST(Treelet, SharedFitCacheChangesNoTree) {
+    const std::vector<Primitive> primitives = generated_scene(30, 5);
+    detail::TreeletFitCache shared(primitives.size());
+    std::uint64_t fresh_fits = 0;
+    std::uint64_t shared_fits = 0;
+    for (Algorithm algorithm : {Algorithm::split, Algorithm::insertion, Algorithm::merge, Algorithm::binned}) {
+        const Bvh input = build_with(primitives, algorithm);
+        TreeletReport alone_report;
+        TreeletReport shared_report;
+        const Bvh alone = refine_treelets(input, VolumePolicy::all(), {}, &alone_report);
+        const Bvh with_shared = detail::refine_treelets_cached(input, VolumePolicy::all(), {}, shared, &shared_report);
+        SCOPED_TRACE(std::string(to_string(algorithm)));
+        test_support::expect_identical_trees(alone, with_shared);
+        EXPECT_EQ(alone_report.cost_after, shared_report.cost_after);
+        fresh_fits += alone_report.fits;
+        shared_fits += shared_report.fits;
+    }
+    EXPECT_LT(shared_fits, fresh_fits);
 }
 
 TEST(Treelet, RefineOptionAppliesToAnyBuilder) {

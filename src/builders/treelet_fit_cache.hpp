@@ -1,0 +1,52 @@
+// SPDX-License-Identifier: MIT
+// Internal: the fits treelet refinement makes, kept across refinements of different trees over the same
+// primitives, so that auto's portfolio (one refinement per member) fits each covered set once.
+#pragma once
+
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include "hbvh/builders/treelet.hpp"
+#include "hbvh/geometry/bounding_volume.hpp"
+
+namespace hbvh::detail {
+
+/// fit_best over one covered set and its weighted volume.
+struct TreeletFit {
+    BoundingVolume volume;
+    double weighted = 0.0;
+};
+
+/// FNV-1a over the sorted primitive indices of a covered set.
+struct CoveredSetHash {
+    std::size_t operator()(const std::vector<std::uint32_t>& key) const {
+        std::uint64_t h = 1469598103934665603ull;
+        for (std::uint32_t v : key) {
+            h ^= v;
+            h *= 1099511628211ull;
+        }
+        return static_cast<std::size_t>(h);
+    }
+};
+
+/// Fits by covered set (sorted input indices). A refinement's fit of a set depends on nothing but the set,
+/// the primitives and the policy, so sharing the cache between refinements of trees built over the same
+/// primitives (in input order, as every Bvh keeps them) under the same policy changes no result.
+class TreeletFitCache {
+public:
+    explicit TreeletFitCache(std::size_t primitive_count) : primitive_count_(primitive_count) {}
+    [[nodiscard]] std::size_t primitive_count() const { return primitive_count_; }
+    std::unordered_map<std::vector<std::uint32_t>, TreeletFit, CoveredSetHash> fits;
+
+private:
+    std::size_t primitive_count_;
+};
+
+/// refine_treelets with fits looked up in, and added to, `cache`. Precondition: every tree refined with
+/// one cache has the same primitives and is refined under the same policy. The report's `fits` counts the
+/// fits this call made, not those it found.
+[[nodiscard]] Bvh refine_treelets_cached(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options,
+                                         TreeletFitCache& cache, TreeletReport* report = nullptr);
+
+}  // namespace hbvh::detail
