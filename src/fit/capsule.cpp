@@ -49,13 +49,25 @@ struct AxisDistances {
 /// t0 = min(t_i + h_i), t1 = max(t_i - h_i); when t1 < t0 any single point of [t1, t0] works and the capsule
 /// is a sphere.
 std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
-    double t0 = std::numeric_limits<double>::infinity();
-    double t1 = -std::numeric_limits<double>::infinity();
+    // Two spheres per step in SSE2 lanes (this loop is the capsule fitter's inner loop). min and max are
+    // exact, so the lanes' order changes no result.
+    using Pair = Eigen::Array2d;
     const std::size_t count = a.axial.size();
     const double* axial = a.axial.data();
     const double* own = a.radius.data();
     const double* d2 = a.distance_squared.data();
-    for (std::size_t i = 0; i < count; ++i) {
+    Pair low = Pair::Constant(std::numeric_limits<double>::infinity());
+    Pair high = Pair::Constant(-std::numeric_limits<double>::infinity());
+    std::size_t i = 0;
+    for (; i + 2 <= count; i += 2) {
+        const Pair slack = radius - Pair::Map(own + i);
+        const Pair h = (slack * slack - Pair::Map(d2 + i)).max(0.0).sqrt();
+        low = low.min(Pair::Map(axial + i) + h);
+        high = high.max(Pair::Map(axial + i) - h);
+    }
+    double t0 = std::min(low[0], low[1]);
+    double t1 = std::max(high[0], high[1]);
+    for (; i < count; ++i) {
         const double slack = radius - own[i];
         const double h = std::sqrt(std::max(0.0, slack * slack - d2[i]));
         t0 = std::min(t0, axial[i] + h);
