@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // fit_capsule: for each candidate axis direction the smallest capsule along it, then the best of them.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -23,16 +24,15 @@ struct Projected {
     std::vector<detail::Circle> section;
 };
 
-Projected project(std::span<const Sphere> spheres, const Mat3& frame) {
-    Projected p;
-    p.axial.reserve(spheres.size());
-    p.section.reserve(spheres.size());
+/// Fills `p` (cleared first; its storage is reused across the fitter's ~100 directions).
+void project(std::span<const Sphere> spheres, const Mat3& frame, Projected& p) {
+    p.axial.clear();
+    p.section.clear();
     for (const Sphere& s : spheres) {
         const Vec3 local = frame.transpose() * s.center;
         p.axial.push_back(local.x());
         p.section.push_back({Eigen::Vector2d(local.y(), local.z()), s.radius});
     }
-    return p;
 }
 
 /// Per-sphere numbers the radius search reads: axial coordinate, own radius and squared distance from the
@@ -81,13 +81,21 @@ double capsule_volume(double radius, double length) {
     return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
 }
 
+/// The buffers capsule_along fills, kept by the caller so that one fit allocates them once, not once per
+/// direction (allocation was a tenth of the capsule fitter's time).
+struct CapsuleScratch {
+    Projected projected;
+    AxisDistances distances;
+};
+
 /// A capsule along column 0 of `frame` (a proper rotation) around `spheres`.
 /// exact_line: place the axis at the centre of the minimum enclosing circle of the cross-sections (the
 /// smallest possible radius) and search for a larger radius that shortens the capsule enough to pay off;
 /// otherwise use the cross-sections' bounding-rectangle centre and the smallest radius, a cheap
 /// estimate for ranking directions.
-Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool exact_line) {
-    const Projected p = project(spheres, frame);
+Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool exact_line, CapsuleScratch& scratch) {
+    Projected& p = scratch.projected;
+    project(spheres, frame, p);
     Eigen::Vector2d line = Eigen::Vector2d::Zero();
     if (exact_line) {
         line = detail::min_circle_of_circles(p.section).center;
@@ -100,7 +108,7 @@ Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool e
         }
         line = 0.5 * (low + high);
     }
-    AxisDistances distances;
+    AxisDistances& distances = scratch.distances;
     distances.axial = p.axial;
     distances.radius.resize(p.section.size());
     distances.distance_squared.resize(p.section.size());
@@ -122,16 +130,17 @@ Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool e
     if (exact_line && first_length > 0.0) {
         // A fatter capsule can be shorter: the end caps then swallow spheres near the ends. Sample radii
         // geometrically up to one length more, then golden-section search around the best sample.
-        std::vector<double> radii{min_radius};
-        for (double g = 1.0 / 64.0; g <= 1.0; g *= 2.0) radii.push_back(min_radius + g * first_length);
+        std::array<double, 8> radii{min_radius};
+        std::size_t sampled = 1;
+        for (double g = 1.0 / 64.0; g <= 1.0; g *= 2.0) radii[sampled++] = min_radius + g * first_length;
         std::size_t best = 0;
         double best_volume = volume_at(radii[0]);
-        for (std::size_t i = 1; i < radii.size(); ++i) {
+        for (std::size_t i = 1; i < sampled; ++i) {
             const double v = volume_at(radii[i]);
             if (v < best_volume) best = i, best_volume = v;
         }
         double a = radii[best == 0 ? 0 : best - 1];
-        double b = radii[std::min(best + 1, radii.size() - 1)];
+        double b = radii[std::min(best + 1, sampled - 1)];
         radius = radii[best];
         const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
         double x1 = b - ratio * (b - a);
@@ -196,10 +205,11 @@ Capsule detail::fit_capsule_in(const FitContext& context, std::span<const Sphere
 
     // Stage 2: rank directions by a cheap capsule (axis through the centre of the cross-sections' bounding
     // rectangle) around the proxy: hull vertices and spheres of positive radius.
+    CapsuleScratch scratch;
     std::vector<std::pair<double, std::size_t>> ranked;
     ranked.reserve(directions.size());
     for (std::size_t i = 0; i < directions.size(); ++i)
-        ranked.emplace_back(capsule_along(proxy.spheres, detail::frame_from_axis(directions[i]), false).volume(), i);
+        ranked.emplace_back(capsule_along(proxy.spheres, detail::frame_from_axis(directions[i]), false, scratch).volume(), i);
     const std::size_t keep = std::min<std::size_t>(3, ranked.size());
     std::partial_sort(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(keep), ranked.end());
 
@@ -208,10 +218,10 @@ Capsule detail::fit_capsule_in(const FitContext& context, std::span<const Sphere
     // dropped points lie in the hull of the kept ones), for less work.
     std::span<const Sphere> kept = proxy.spheres;
     Vec3 best_direction = point_frame.col(0);
-    Capsule best = capsule_along(kept, detail::frame_from_axis(best_direction), true);
+    Capsule best = capsule_along(kept, detail::frame_from_axis(best_direction), true, scratch);
     for (std::size_t i = 0; i < keep; ++i) {
         const Vec3& direction = directions[ranked[i].second];
-        Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true);
+        Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true, scratch);
         if (candidate.volume() < best.volume()) best = candidate, best_direction = direction;
     }
 
@@ -225,7 +235,7 @@ Capsule detail::fit_capsule_in(const FitContext& context, std::span<const Sphere
         for (int axis = 1; axis <= 2; ++axis)
             for (double sign : {1.0, -1.0}) {
                 const Vec3 direction = Eigen::AngleAxisd(sign * step, frame.col(axis)) * best_direction;
-                Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true);
+                Capsule candidate = capsule_along(kept, detail::frame_from_axis(direction), true, scratch);
                 ++evaluations;
                 if (candidate.volume() < best.volume() * (1.0 - 1e-12))
                     best = candidate, best_direction = direction, improved = true;
