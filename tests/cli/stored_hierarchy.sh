@@ -2,7 +2,7 @@
 # SPDX-License-Identifier: MIT
 # Stored hierarchies are checked before use: a file whose inner volumes miss part of their primitives
 # (the repository's own repaired appendix B) is refused by every command that queries or draws it, with
-# the file, line, primitive and distance, and nothing written; --refit repairs it and the pairs then equal
+# the file, line, primitive and distance, and nothing written (convert included); --refit repairs it and the pairs then equal
 # a query that never sees the stored volumes; stats reports the violations instead of failing.
 # Usage: stored_hierarchy.sh HBVH_BINARY SOURCE_DIR WORK_DIR
 set -euo pipefail
@@ -27,6 +27,7 @@ expect_refusal simulate "" simulate "$broken" --collisions 10
 expect_refusal export "$work/x.gltf" export "$broken" -o "$work/x.gltf"
 expect_refusal view "$work/x.html" view "$source_dir/tests/io/data/survey_appendix_b_repaired.xml" -o "$work/x.html"
 expect_refusal build "$work/x.xml" build "$broken" -o "$work/x.xml"
+expect_refusal convert "$work/x.hbvh" convert "$broken" -o "$work/x.hbvh"
 # The line named is the first offending volume's own line in the file.
 line=$(sed -E 's/.*repaired.xml:([0-9]+):.*/\1/' "$work/collide.err")
 sed -n "${line}p" "$broken" | grep -q '<volume' || fail "line $line of the file is no <volume>"
@@ -71,4 +72,12 @@ assert refit["pairs"], "the test pose should make contact"
 PY
 "$hbvh" export --refit "$broken" -o "$work/refit.gltf" 2>/dev/null
 [ -s "$work/refit.gltf" ] || fail "export --refit wrote nothing"
+# convert --refit writes the repaired tree, which every command then accepts as it is.
+"$hbvh" convert --refit "$broken" -o "$work/refit.hbvh" 2>/dev/null
+"$hbvh" collide "$work/refit.hbvh" "$work/refit.hbvh" --pose-b "0.5 0.2 0 0.9 0.1 0.4 0" --json >"$work/converted.json"
+python3 - "$work/refit.json" "$work/converted.json" <<'PY'
+import json, sys
+refit, converted = (json.load(open(p)) for p in sys.argv[1:])
+assert refit["pairs"] == converted["pairs"], (refit["pairs"], converted["pairs"])
+PY
 echo "stored_hierarchy: ok"
