@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 #include <cmath>
+#include <optional>
 #include <sstream>
 
 #include "commands/command.hpp"
@@ -15,8 +16,8 @@ namespace {
 struct CollideArguments {
     std::string input_a;
     std::string input_b;
-    std::string pose_a;
-    std::string pose_b;
+    std::optional<std::string> pose_a;  ///< Absent: the identity. Given, even empty, it must parse.
+    std::optional<std::string> pose_b;
     BuilderFlags builder;
     bool first = false;
     bool json = false;
@@ -51,8 +52,8 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
 }
 
 int run_collide(const CollideArguments& args) {
-    Result<RigidTransform> pose_a = args.pose_a.empty() ? Result<RigidTransform>(RigidTransform{}) : parse_pose(args.pose_a, "--pose-a");
-    Result<RigidTransform> pose_b = args.pose_b.empty() ? Result<RigidTransform>(RigidTransform{}) : parse_pose(args.pose_b, "--pose-b");
+    Result<RigidTransform> pose_a = args.pose_a ? parse_pose(*args.pose_a, "--pose-a") : Result<RigidTransform>(RigidTransform{});
+    Result<RigidTransform> pose_b = args.pose_b ? parse_pose(*args.pose_b, "--pose-b") : Result<RigidTransform>(RigidTransform{});
     for (const Result<RigidTransform>* pose : {&pose_a, &pose_b})
         if (!*pose) {
             fmt::print(stderr, "hbvh collide: {}\n", pose->error().to_string());
@@ -94,7 +95,7 @@ void add_collide_command(CLI::App& app, Command& command) {
     sub->add_option("a", args->input_a, "First object: a hierarchy or a primitive set")->required();
     sub->add_option("b", args->input_b, "Second object")->required();
     sub->add_option("--pose-a", args->pose_a, "Pose of a: \"tx ty tz [qw qx qy qz]\" (default identity)");
-    sub->add_option("--pose-b", args->pose_b, "Pose of b");
+    sub->add_option("--pose-b", args->pose_b, "Pose of b (default identity)");
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
     sub->add_flag("--first", args->first, "Stop at the first overlapping pair");
