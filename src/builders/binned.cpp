@@ -13,6 +13,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "guarded_build.hpp"
@@ -513,8 +514,21 @@ private:
             thread_local std::vector<Sphere> spheres;
             spheres.clear();
             for (const Ref& ref : range) spheres.insert(spheres.end(), ref.spheres.begin(), ref.spheres.end());
-            if (size <= dito_max)
-                for (const Mat3& frame : detail::dito_frames(spheres)) consider(detail::obb_with_axes(spheres, frame));
+            if (size <= dito_max) {
+                // Under the volume measure a frame whose box cannot beat the best so far is dropped after its
+                // first pass, often after a few spheres (the same choice: `consider` keeps only a smaller one).
+                // The margin covers the rounding of the volume and of the division.
+                const bool can_bound = policy.measure == NodeMeasure::volume;
+                for (const Mat3& frame : detail::dito_frames(spheres)) {
+                    if (!can_bound) {
+                        consider(detail::obb_with_axes(spheres, frame));
+                        continue;
+                    }
+                    const double limit = best_volume / policy.weight_of(BvType::obb) * (1.0 + 1e-9);
+                    if (std::optional<Obb> box = detail::obb_with_axes_below(spheres, frame, limit))
+                        consider(std::move(*box));
+                }
+            }
             if (hull_over_spheres) consider(fit(BvType::obb, spheres));
         }
         if (want_obb && around_children) consider(fit(BvType::obb, around));

@@ -6,6 +6,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <Eigen/Eigenvalues>
 
@@ -83,6 +84,7 @@ Mat3 frame_from_axis(const Vec3& axis) {
 std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     // Stage 1: extremal spheres along each fixed direction (support value c.n +- r).
     std::vector<Vec3> extremal;
+    extremal.reserve(2 * dito_normals().size());
     for (const Vec3& n : dito_normals()) {
         double low = infinity;
         double high = -infinity;
@@ -126,7 +128,9 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     const Vec3 normal = (p1 - p0).cross(p2 - p0).normalized();
 
     // Stage 4: the apexes above and below the base plane make a ditetrahedron of up to 7 triangles.
-    std::vector<std::array<Vec3, 3>> triangles{{p0, p1, p2}};
+    std::vector<std::array<Vec3, 3>> triangles;
+    triangles.reserve(7);
+    triangles.push_back({p0, p1, p2});
     std::size_t top = 0;
     std::size_t bottom = 0;
     for (std::size_t i = 0; i < extremal.size(); ++i) {
@@ -144,6 +148,7 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
 
     // Stage 5: each edge of each triangle, with the triangle's normal, spans one frame.
     std::vector<Mat3> frames;
+    frames.reserve(3 * triangles.size());
     for (const auto& t : triangles) {
         const Vec3 n = (t[1] - t[0]).cross(t[2] - t[0]);
         if (!(n.norm() > tiny * std::sqrt(farthest))) continue;
@@ -251,15 +256,12 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     return frames;
 }
 
-Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
+namespace {
+
+/// The box with axes `rotation` whose local extent is [low, high], grown until it contains every sphere as
+/// Obb::contains measures it (re-centring rounds), then padded.
+Obb finish_box(std::span<const Sphere> spheres, const Mat3& rotation, const Vec3& low, const Vec3& high) {
     const Mat3 to_local = rotation.transpose();
-    Vec3 low = Vec3::Constant(infinity);
-    Vec3 high = Vec3::Constant(-infinity);
-    for (const Sphere& s : spheres) {
-        const Vec3 local = to_local * s.center;
-        low = low.cwiseMin(local - Vec3::Constant(s.radius));
-        high = high.cwiseMax(local + Vec3::Constant(s.radius));
-    }
     Obb box{rotation * (0.5 * (low + high)), rotation, 0.5 * (high - low)};
     // Re-centring rounds; grow by whatever the containment test itself measures, so it holds exactly.
     for (const Sphere& s : spheres) {
@@ -270,6 +272,37 @@ Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
     // with its distance from the origin.
     box.half_extents.array() += rounding_pad(box.half_extents.maxCoeff());
     return box;
+}
+
+}  // namespace
+
+Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
+    const Mat3 to_local = rotation.transpose();
+    Vec3 low = Vec3::Constant(infinity);
+    Vec3 high = Vec3::Constant(-infinity);
+    for (const Sphere& s : spheres) {
+        const Vec3 local = to_local * s.center;
+        low = low.cwiseMin(local - Vec3::Constant(s.radius));
+        high = high.cwiseMax(local + Vec3::Constant(s.radius));
+    }
+    return finish_box(spheres, rotation, low, high);
+}
+
+std::optional<Obb> obb_with_axes_below(std::span<const Sphere> spheres, const Mat3& rotation, double limit) {
+    const Mat3 to_local = rotation.transpose();
+    Vec3 low = Vec3::Constant(infinity);
+    Vec3 high = Vec3::Constant(-infinity);
+    for (std::size_t i = 0; i < spheres.size(); ++i) {
+        const Sphere& s = spheres[i];
+        const Vec3 local = to_local * s.center;
+        low = low.cwiseMin(local - Vec3::Constant(s.radius));
+        high = high.cwiseMax(local + Vec3::Constant(s.radius));
+        // The extent only grows, and the finished box only grows it further: once this product reaches the
+        // limit the box cannot end below it.
+        if (i % 8 == 7 && (high - low).prod() >= limit) return std::nullopt;
+    }
+    if ((high - low).prod() >= limit) return std::nullopt;
+    return finish_box(spheres, rotation, low, high);
 }
 
 double proxy_obb_volume(const SphereProxy& proxy, const Mat3& rotation) {

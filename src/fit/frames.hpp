@@ -2,6 +2,7 @@
 // Internal: candidate orientations shared by the OBB and capsule fitters, and box evaluation per frame.
 #pragma once
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -58,6 +59,13 @@ inline constexpr std::size_t max_ranked_hints = 8;
 /// The smallest box with axes `rotation` containing every sphere exactly (in double arithmetic:
 /// Obb::contains with zero tolerance holds for each input). O(n).
 [[nodiscard]] Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation);
+
+/// obb_with_axes when that box's volume can be below `limit`, else nothing (often after a few spheres): the
+/// box's volume is at least the product of its first pass's extents, which only grow. So any box returned
+/// is the one obb_with_axes returns, and a box not returned has a volume of at least `limit`, up to the
+/// rounding of the two volume products (callers pass a limit with a margin above what they compare with).
+[[nodiscard]] std::optional<Obb> obb_with_axes_below(std::span<const Sphere> spheres, const Mat3& rotation,
+                                                     double limit);
 
 /// Volume of the smallest box with axes `rotation` around the proxy's spheres (equal to obb_with_axes'
 /// volume on the full set, up to rounding).
