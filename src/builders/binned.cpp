@@ -386,8 +386,8 @@ private:
         pieces(nodes_[slot].right, k - left_share, out);
     }
 
-    /// The kept nodes below and at `slot` (kept with `k` children), children before parents, with the
-    /// moments of each (when a frame is fitted).
+    /// The kept nodes below and at `slot` (kept with `k` children), children before parents. Their moments
+    /// are summed later, in parallel, by fit_subtree (this walk is serial, and summing here was most of it).
     void collect(std::uint32_t slot, std::uint32_t k, std::vector<WideNode>& wide) {
         WideNode node;
         node.slot = slot;
@@ -395,18 +395,26 @@ private:
         pieces(nodes_[slot].left, split_of(slot)[k], pieces_);
         pieces(nodes_[slot].right, k - split_of(slot)[k], pieces_);
         node.piece_count = static_cast<std::uint32_t>(pieces_.size()) - node.first_piece;
+        for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p) {
+            const std::uint32_t child = pieces_[p];
+            if (!nodes_[child].is_leaf) collect(child, split_of(child)[1], wide);
+        }
+        wide.push_back(node);
+    }
+
+    /// The moments of kept node `node` from its pieces, left to right: a leaf's spheres, a kept child's sum
+    /// (already made: children are fitted first). The same additions in the same order whichever thread
+    /// runs them, so the sums do not depend on the thread count.
+    [[nodiscard]] Moments moments_of(const WideNode& node, const std::vector<std::uint32_t>& wide_of_slot) const {
         Moments sum;
         for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p) {
             const std::uint32_t child = pieces_[p];
-            if (nodes_[child].is_leaf) {
-                if (needs_moments_) sum.add(refs_[nodes_[child].begin].spheres);
-                continue;
-            }
-            collect(child, split_of(child)[1], wide);
-            if (needs_moments_) sum.add(moments_.back());
+            if (nodes_[child].is_leaf)
+                sum.add(refs_[nodes_[child].begin].spheres);
+            else
+                sum.add(moments_[wide_of_slot[child]]);
         }
-        wide.push_back(node);
-        if (needs_moments_) moments_.push_back(sum);
+        return sum;
     }
 
     // ---- Step 3: one fit per kept node -----------------------------------------------------------------
@@ -416,6 +424,7 @@ private:
     void fit_all(std::vector<WideNode>& wide) {
         std::vector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
         for (std::uint32_t i = 0; i < wide.size(); ++i) wide_of_slot[wide[i].slot] = i;
+        if (needs_moments_) moments_.resize(wide.size());
         std::atomic<std::uint64_t> fitted{0};
         fit_subtree(static_cast<std::uint32_t>(wide.size() - 1), wide, wide_of_slot, fitted);
     }
@@ -432,6 +441,7 @@ private:
             tbb::parallel_for(std::size_t{0}, inner.size(), [&](std::size_t i) { fit_subtree(inner[i], wide, wide_of_slot, fitted); });
         else
             for (const std::uint32_t child : inner) fit_subtree(child, wide, wide_of_slot, fitted);
+        if (needs_moments_) moments_[index] = moments_of(node, wide_of_slot);
         node.volume = fit_node(node, wide, wide_of_slot, needs_moments_ ? moments_[index] : Moments{});
         const double n = static_cast<double>(refs_.size());
         const auto done = static_cast<double>(fitted.fetch_add(1, std::memory_order_relaxed) + 1);
