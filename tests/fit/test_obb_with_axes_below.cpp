@@ -45,7 +45,9 @@ TEST(ObbWithAxesBelow, ReturnsTheSameBoxOrOneNotBelowTheLimit) {
         }
         // A limit above the volume by more than rounding always gets the box (a lone point has volume 0,
         // and nothing is below a limit of 0).
-        if (v > 0.0) EXPECT_TRUE(detail::obb_with_axes_below(spheres, rotation, v * 2.0).has_value()) << trial;
+        if (v > 0.0) {
+            EXPECT_TRUE(detail::obb_with_axes_below(spheres, rotation, v * 2.0).has_value()) << trial;
+        }
     }
     // Both outcomes were exercised.
     EXPECT_GT(returned, 1000);
