@@ -196,7 +196,9 @@ std::size_t size_limit(hbvh::Algorithm algorithm, bool fits_are_costly) {
         case Algorithm::merge:
         case Algorithm::obb_tree: return fits_are_costly ? 14 : max_primitives;
         case Algorithm::insertion:
-        case Algorithm::split: return fits_are_costly ? 10 : max_primitives;
+        case Algorithm::split:
+        case Algorithm::binned:
+        case Algorithm::fast: return fits_are_costly ? 10 : max_primitives;
         case Algorithm::scale: return fits_are_costly ? 5 : 16;
         case Algorithm::insertion_haber: return fits_are_costly ? 4 : max_primitives;
         case Algorithm::bnb_enlarge: return fits_are_costly ? 4 : 10;

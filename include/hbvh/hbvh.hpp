@@ -40,6 +40,7 @@
 #include <hbvh/builders/budget.hpp>
 #include <hbvh/builders/build.hpp>
 #include <hbvh/builders/context.hpp>
+#include <hbvh/builders/fast.hpp>
 #include <hbvh/builders/insertion.hpp>
 #include <hbvh/builders/insertion_haber.hpp>
 #include <hbvh/builders/merge.hpp>

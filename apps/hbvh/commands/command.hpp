@@ -68,6 +68,7 @@ struct BuildRequest {
 /// Options that select and steer a builder, shared by build, stats, compare, collide.
 struct BuilderFlags {
     std::string algorithm = "auto";
+    std::string quality;  ///< --quality fast|auto: a preset naming the builder instead of -a.
     std::string types = "aabb,obb,sphere,capsule";
     std::string type_weights;
     std::string objective = "eq2";  ///< --objective: eq2 (the survey's volume) or calibrated (Minkowski measure).

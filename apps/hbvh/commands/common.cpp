@@ -120,8 +120,14 @@ void report_warnings(const std::vector<std::string>& warnings) {
 }
 
 void BuilderFlags::add_to(CLI::App& command) {
-    command.add_option("-a,--algorithm", algorithm, "Construction algorithm (see `hbvh algorithms`)")
-        ->capture_default_str();
+    CLI::Option* algorithm_option =
+        command.add_option("-a,--algorithm", algorithm, "Construction algorithm (see `hbvh algorithms`)")
+            ->capture_default_str();
+    command.add_option("--quality", quality,
+                       "Preset instead of -a: fast (builds in about a millisecond for dozens of primitives, trees "
+                       "that cost more) or auto (the default: the cheapest trees, in 0.1-1 s)")
+        ->check(CLI::IsMember({"fast", "auto"}))
+        ->excludes(algorithm_option);
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
                        "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each), or @FILE as `hbvh calibrate` writes");
@@ -142,8 +148,10 @@ void BuilderFlags::add_to(CLI::App& command) {
 }
 
 Result<BuildRequest> BuilderFlags::resolve() const {
-    const std::optional<Algorithm> chosen = parse_algorithm(algorithm);
-    if (!chosen) return Error{"unknown algorithm '" + algorithm + "' (see `hbvh algorithms`)"};
+    // --quality names a registered builder too: "fast" and "auto".
+    const std::string& name = quality.empty() ? algorithm : quality;
+    const std::optional<Algorithm> chosen = parse_algorithm(name);
+    if (!chosen) return Error{"unknown algorithm '" + name + "' (see `hbvh algorithms`)"};
     Result<VolumePolicy> policy = parse_allowed_types(types);
     if (!policy) return policy.error();
     if (!type_weights.empty()) {

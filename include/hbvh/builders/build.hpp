@@ -10,6 +10,7 @@
 #include "hbvh/builders/bnb_exact.hpp"
 #include "hbvh/builders/bnb_tightest.hpp"
 #include "hbvh/builders/context.hpp"
+#include "hbvh/builders/fast.hpp"
 #include "hbvh/builders/insertion.hpp"
 #include "hbvh/builders/insertion_haber.hpp"
 #include "hbvh/builders/merge.hpp"

@@ -29,6 +29,7 @@ enum class Algorithm {
     obb_tree,
     scale,
     binned,
+    fast,
     automatic,  ///< "auto"
 };
 

@@ -1,0 +1,102 @@
+// SPDX-License-Identifier: MIT
+// fast: binned's tree with its cheap fits, then fit_best on the nodes that weigh most in Eq. 2.
+#include "hbvh/builders/fast.hpp"
+
+#include <algorithm>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <tbb/parallel_for.h>
+
+#include "guarded_build.hpp"
+#include "hbvh/builders/binned.hpp"
+#include "hbvh/fit/fit.hpp"
+
+namespace hbvh {
+namespace {
+
+/// binned without its two slow steps for small inputs: the per-side fits of its cuts (estimate sweeps) and
+/// fit_best on every kept node. What is left is the box-priced cuts, the collapse and one cheap fit a node.
+BinnedOptions cheap_binned() {
+    BinnedOptions options;
+    options.estimate_sweep_up_to = 0;
+    options.exact_fit_all_up_to = 0;
+    return options;
+}
+
+/// Primitives below each node (nodes are breadth-first, so children come after their parent).
+std::vector<std::uint32_t> primitive_counts(const Bvh& bvh) {
+    std::vector<std::uint32_t> counts(bvh.nodes.size(), 0);
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+        const Node& node = bvh.nodes[i];
+        if (node.is_leaf()) counts[i] = 1;
+        for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) counts[i] += counts[c];
+    }
+    return counts;
+}
+
+/// The `count` inner nodes over at most `max_primitives` primitives with the largest children x weighted volume
+/// (their Eq. 2 terms), largest first (ties: the lower index).
+std::vector<std::uint32_t> heaviest_inner_nodes(const Bvh& bvh, const VolumePolicy& policy, std::uint32_t count,
+                                                std::uint32_t max_primitives) {
+    const std::vector<std::uint32_t> below = primitive_counts(bvh);
+    std::vector<std::pair<double, std::uint32_t>> terms;
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const Node& node = bvh.nodes[i];
+        if (!node.is_leaf() && below[i] <= max_primitives)
+            terms.emplace_back(node.child_count * policy.weighted_volume(node.volume), i);
+    }
+    const std::size_t keep = std::min<std::size_t>(count, terms.size());
+    std::partial_sort(terms.begin(), terms.begin() + static_cast<std::ptrdiff_t>(keep), terms.end(),
+                      [](const auto& a, const auto& b) { return a.first > b.first || (a.first == b.first && a.second < b.second); });
+    std::vector<std::uint32_t> nodes;
+    for (std::size_t k = 0; k < keep; ++k) nodes.push_back(terms[k].second);
+    return nodes;
+}
+
+/// fit_best over the primitives below `node`.
+BoundingVolume best_fit_below(const Bvh& bvh, std::uint32_t node, const VolumePolicy& policy) {
+    FitInput input;
+    for (const std::uint32_t p : covered_primitives(bvh, node)) input.add(bvh.primitives[p].volume);
+    return fit_best(input.spheres, policy, input.hint_axes);
+}
+
+}  // namespace
+
+Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context, const FastOptions& options) {
+    // binned reports its progress as the first half, the refits the second.
+    BuildContext first_step = context;
+    if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };
+    Result<Bvh> built = build_binned(primitives, first_step, cheap_binned());
+    if (!built || context.expired() || options.exact_fits == 0) return built;
+    Bvh& bvh = *built;
+    const std::vector<std::uint32_t> heaviest =
+        heaviest_inner_nodes(bvh, context.policy, options.exact_fits, options.exact_fit_max_primitives);
+    // Each refit reads the tree's shape and primitives only, so they run in parallel and the result does not
+    // depend on the thread count (without a deadline; with one, a refit that would start after it is skipped).
+    std::vector<std::optional<BoundingVolume>> refits(heaviest.size());
+    tbb::parallel_for(std::size_t{0}, heaviest.size(), [&](std::size_t k) {
+        if (!context.expired()) refits[k] = best_fit_below(bvh, heaviest[k], context.policy);
+    });
+    std::size_t kept = 0;
+    for (std::size_t k = 0; k < heaviest.size(); ++k) {
+        if (!refits[k]) continue;
+        Node& node = bvh.nodes[heaviest[k]];
+        // fit_best tries more frames than the cheap fit but not all of them (DiTO's frames are binned's, the
+        // principal frame of the centres too), so it can come out larger: keep whichever is cheaper.
+        if (context.policy.weighted_volume(*refits[k]) < context.policy.weighted_volume(node.volume)) {
+            node.volume = std::move(*refits[k]);
+            ++kept;
+        }
+    }
+    if (context.report != nullptr)
+        context.report->notes.push_back("fast: fit_best on the " + std::to_string(heaviest.size()) +
+                                        " heaviest inner nodes, cheaper on " + std::to_string(kept));
+    if (context.expired()) context.note_deadline("fast: refits after the deadline skipped");
+    context.report_progress(1.0);
+    return detail::check_build_output(std::move(built), "fast");
+}
+
+}  // namespace hbvh
