@@ -141,3 +141,12 @@ set_tests_properties(cli.calibrate PROPERTIES FIXTURES_SETUP calibrated_weights)
 set_tests_properties(cli.type_weight_file PROPERTIES FIXTURES_REQUIRED calibrated_weights)
 hbvh_cli_test(type_weight_file_missing 2 "no-such-weights.txt" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               --type-weight @${HBVH_CLI_OUT}/no-such-weights.txt -o ${HBVH_CLI_OUT}/unweighted_chair.xml)
+
+# --quality: a preset naming the builder (the report says which one ran); it excludes -a, and only its two
+# values are accepted.
+hbvh_cli_test(quality.fast 0 "fast in [0-9.]+ ms" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality fast --stats
+              -o ${HBVH_CLI_OUT}/quality_fast.hbvh)
+hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality fast
+              -a split -o ${HBVH_CLI_OUT}/quality_excludes.xml)
+hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
+              -o ${HBVH_CLI_OUT}/quality_unknown.xml)

@@ -15,7 +15,7 @@ def extent(primitives):
 
 
 @pytest.mark.parametrize("name", ["chair.xml", "tie_interceptor.xml", "generated", "round"])
-@pytest.mark.parametrize("algorithm", ["auto", "split", "two-level"])
+@pytest.mark.parametrize("algorithm", ["auto", "fast", "split", "two-level"])
 def test_pairs_equal_brute_force(name, algorithm):
     primitives = model(name)
     assert isinstance(primitives, hbvh.Primitives)
