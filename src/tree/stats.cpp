@@ -3,6 +3,9 @@
 
 #include <algorithm>
 #include <limits>
+#include <vector>
+
+#include "box_overlap.hpp"
 
 namespace hbvh {
 namespace {
@@ -27,11 +30,6 @@ private:
     std::uint64_t count_ = 0;
 };
 
-double intersection_volume(const Aabb& a, const Aabb& b) {
-    const Vec3 lo = a.min.cwiseMax(b.min);
-    const Vec3 hi = a.max.cwiseMin(b.max);
-    return (hi - lo).cwiseMax(Vec3::Zero()).prod();
-}
 }  // namespace
 
 double cost(const Bvh& bvh, const VolumePolicy& policy) {
@@ -53,6 +51,7 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
 
     // Depths follow from the breadth-first layout: a child is deeper than its parent by one.
     std::vector<std::uint32_t> depth(bvh.nodes.size(), 0);
+    std::vector<Aabb> child_boxes;
     for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
         const Node& node = bvh.nodes[i];
         ++stats.types[static_cast<std::size_t>(type_of(node.volume))];
@@ -65,16 +64,16 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
         ++stats.inner_nodes;
         branching.add(node.child_count);
         double children_volume = 0.0;
+        child_boxes.clear();
         for (std::uint32_t c = 0; c < node.child_count; ++c) {
             const Node& child = bvh.nodes[node.first_child + c];
             depth[node.first_child + c] = depth[i] + 1;
             children_volume += volume(child.volume);
-            // Sibling overlap: pairwise intersection of the children's world AABBs (docs/metrics.md).
-            const Aabb child_box = world_aabb(child.volume);
-            sibling_volume += child_box.volume();
-            for (std::uint32_t d = c + 1; d < node.child_count; ++d)
-                overlap_volume += intersection_volume(child_box, world_aabb(bvh.nodes[node.first_child + d].volume));
+            child_boxes.push_back(world_aabb(child.volume));
+            sibling_volume += child_boxes.back().volume();
         }
+        // Sibling overlap: pairwise intersection of the children's world AABBs (docs/metrics.md).
+        overlap_volume += detail::pairwise_intersection_volume(child_boxes);
         if (children_volume > 0.0) tightness.add(volume(node.volume) / children_volume);
     }
     stats.branching = branching.summary();
