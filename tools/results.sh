@@ -403,7 +403,7 @@ if wanted 2; then
         --repeat 1 --markdown >"$work/scale.md"
     cat "$work/scale.md" >>"$doc"
     emit ""
-    emit "**What it shows.** One build each (\`--repeat 1\`); \`auto\` keeps the cheaper of \`scale\` and \`split\` up to 20 000 primitives."
+    emit "**What it shows.** One build each (\`--repeat 1\`); \`auto\` is the cheaper of \`binned\` and \`split\` at 1000 primitives and \`binned\` alone above 2000 (docs/scale.md §9)."
     summarise scale_summary "$work/scale.md"
     if [[ ${HBVH_RESULTS_1M:-0} == 1 ]]; then
         log "  10^6 bench (several minutes)"
