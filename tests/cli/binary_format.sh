@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# The .hbvh binary format through the CLI: build and convert write it by extension, every command reads it
+# The .hbvh binary format through the CLI: build, convert and generate write it by extension, every command reads it
 # (by extension, or by its magic bytes on stdin), stats and collide on it equal stats and collide on the same
 # tree as XML, and a truncated, corrupted or non-enclosing binary file is refused like a bad XML one.
 # Usage: binary_format.sh HBVH_BINARY SOURCE_DIR WORK_DIR
@@ -109,4 +109,10 @@ expect_refusal shrunk_build "shrunk\.hbvh: volume" build "$work/shrunk.hbvh" -o 
 [ ! -e "$work/never.hbvh" ] || fail "build wrote its output although the input was refused"
 "$hbvh" collide --refit "$work/shrunk.hbvh" "$model" >/dev/null 2>"$work/refit.err" || fail "--refit did not repair"
 grep -q "refitted" "$work/refit.err" || fail "--refit did not say what it changed: $(cat "$work/refit.err")"
+# generate writes the binary format by extension too, and the set it writes is the one it writes as XML.
+"$hbvh" generate --count 40 --seed 5 -o "$work/generated.hbvh"
+"$hbvh" generate --count 40 --seed 5 -o "$work/generated.xml"
+head -c 8 "$work/generated.hbvh" | od -An -tx1 | grep -q '89 48 42 56 48 0d 0a 1a' || fail "generated.hbvh does not start with the magic"
+"$hbvh" convert "$work/generated.hbvh" -o "$work/generated_again.xml"
+cmp -s "$work/generated.xml" "$work/generated_again.xml" || fail "generate -o .hbvh holds another set than generate -o .xml"
 echo "binary_format: ok"
