@@ -197,9 +197,9 @@ std::size_t size_limit(hbvh::Algorithm algorithm, bool fits_are_costly) {
         case Algorithm::obb_tree: return fits_are_costly ? 14 : max_primitives;
         case Algorithm::insertion:
         case Algorithm::split:
-        case Algorithm::binned:
         case Algorithm::fast: return fits_are_costly ? 10 : max_primitives;
-        case Algorithm::scale: return fits_are_costly ? 5 : 16;
+        case Algorithm::scale:
+        case Algorithm::binned: return fits_are_costly ? 5 : 16;  // binned builds small inputs twice, fit_best per node
         case Algorithm::insertion_haber: return fits_are_costly ? 4 : max_primitives;
         case Algorithm::bnb_enlarge: return fits_are_costly ? 4 : 10;
         case Algorithm::bnb_tightest:
