@@ -31,7 +31,7 @@ Bvh fast(std::span<const Primitive> primitives, const VolumePolicy& policy, Fast
 }
 
 /// The same kind and bit-identical numbers (compared through the generating spheres, which every kind has).
-bool same_volume(const BoundingVolume& a, const BoundingVolume& b) {
+bool identical_volume(const BoundingVolume& a, const BoundingVolume& b) {
     if (a.index() != b.index()) return false;
     const auto sa = generating_spheres(a), sb = generating_spheres(b);
     if (sa.size() != sb.size()) return false;
@@ -86,7 +86,7 @@ TEST(Fast, RefitsExactlyTheHeaviestNodesWithFitBestWhereCheaper) {
                 BoundingVolume exact = fit_best_below(cheap, i, policy);
                 return policy.weighted_volume(exact) < policy.weighted_volume(before.volume) ? exact : before.volume;
             }();
-            EXPECT_TRUE(same_volume(after.volume, expected)) << "node " << i << (is_heaviest ? " (refitted)" : "");
+            EXPECT_TRUE(identical_volume(after.volume, expected)) << "node " << i << (is_heaviest ? " (refitted)" : "");
             if (is_heaviest && policy.weighted_volume(after.volume) < policy.weighted_volume(before.volume)) ++improved;
         }
         expect_tree_properties(primitives, refined);
@@ -101,11 +101,12 @@ TEST(Fast, NodesOverTheCapAreNotRefitted) {
     const Bvh capped = fast(primitives, VolumePolicy::all(), {.exact_fits = 1000, .exact_fit_max_primitives = 3});
     std::uint32_t refitted = 0;
     for (std::uint32_t i = 0; i < cheap.nodes.size(); ++i) {
-        const bool same = same_volume(cheap.nodes[i].volume, capped.nodes[i].volume);
-        if (covered_primitives(cheap, i).size() > 3)
+        const bool same = identical_volume(cheap.nodes[i].volume, capped.nodes[i].volume);
+        if (covered_primitives(cheap, i).size() > 3) {
             EXPECT_TRUE(same) << "node " << i << " over more than 3 primitives was refitted";
-        else if (!same)
+        } else if (!same) {
             ++refitted;
+        }
     }
     EXPECT_GT(refitted, 0u);  // the small ones were
 }

@@ -59,7 +59,9 @@ TEST(BoxOverlap, EqualsThePairByPairSumOnEveryShape) {
             const double expected = every_pair(boxes);
             const double got = detail::pairwise_intersection_volume(boxes);
             EXPECT_NEAR(got, expected, 1e-12 * expected) << "expected " << expected;
-            if (shape != Shape::flat && count >= 300) EXPECT_GT(expected, 0.0);  // the sets do overlap
+            if (shape != Shape::flat && count >= 300) {
+                EXPECT_GT(expected, 0.0);  // the sets do overlap
+            }
         }
 }
 
