@@ -12,25 +12,25 @@
 
 namespace hbvh {
 
-/// Knobs of build_fast. The defaults are the measured compromise (docs/algorithms.md, "fast").
+/// Knobs of build_fast. The defaults are the measured compromise (docs/fast.md).
 struct FastOptions {
     /// After the cheap build, this many inner nodes are refitted with fit_best over their primitives: those
     /// with the largest Eq. 2 terms (children x weighted volume), largest first. The root alone is most of
-    /// the gain on compact objects; each fit costs about 0.1-0.5 ms on a few dozen primitives.
+    /// the gain on compact objects; each fit costs about 0.4-1 ms on a few dozen primitives (docs/fast.md).
     std::uint32_t exact_fits = 2;
     /// Nodes over more primitives than this are not refitted (fit_best is O(n log n) with a large constant:
     /// seconds at 10^6 primitives), so the preset stays fast at any size.
     std::uint32_t exact_fit_max_primitives = 256;
 };
 
-/// A hierarchy in well under a millisecond for a few dozen primitives (O(n log n) beyond the refits):
+/// A hierarchy in about a millisecond for a few dozen primitives (O(n log n) beyond the refits):
 /// 1. binned's binary tree (cuts between sorted centres priced by the sides' boxes), its Eq. 2-optimal
 ///    collapse into nodes of up to 8 children, and its cheap fit of each kept node (exact AABB, the box in the
 ///    principal and DiTO frames, the capsule on the main axis, the sphere around the box centre);
 /// 2. the `exact_fits` inner nodes with the largest children x weighted volume (among those over at most
 ///    `exact_fit_max_primitives` primitives) refitted with fit_best over their primitives, each kept only where
 ///    it is cheaper (so the tree is never costlier than step 1's).
-/// Its trees cost more than `auto`'s (docs/algorithms.md has the table); use it where build time matters more.
+/// Its trees cost more than `auto`'s (docs/fast.md has the table); use it where build time matters more.
 /// Deterministic for any thread count (the refits are independent and run in parallel).
 /// Deadline: binned's checks, then before each refit (once passed, the refits not yet made are skipped).
 [[nodiscard]] Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context,
