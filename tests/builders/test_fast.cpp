@@ -30,16 +30,6 @@ Bvh fast(std::span<const Primitive> primitives, const VolumePolicy& policy, Fast
     return bvh ? std::move(bvh).value() : Bvh{};
 }
 
-/// The same kind and bit-identical numbers (compared through the generating spheres, which every kind has).
-bool identical_volume(const BoundingVolume& a, const BoundingVolume& b) {
-    if (a.index() != b.index()) return false;
-    const auto sa = generating_spheres(a), sb = generating_spheres(b);
-    if (sa.size() != sb.size()) return false;
-    for (std::size_t k = 0; k < sa.size(); ++k)
-        if (sa[k].center != sb[k].center || sa[k].radius != sb[k].radius) return false;
-    return true;
-}
-
 /// fit_best over the primitives below `node`, gathered here from the tree's child ranges.
 BoundingVolume fit_best_below(const Bvh& bvh, std::uint32_t node, const VolumePolicy& policy) {
     FitInput input;
@@ -86,7 +76,7 @@ TEST(Fast, RefitsExactlyTheHeaviestNodesWithFitBestWhereCheaper) {
                 BoundingVolume exact = fit_best_below(cheap, i, policy);
                 return policy.weighted_volume(exact) < policy.weighted_volume(before.volume) ? exact : before.volume;
             }();
-            EXPECT_TRUE(identical_volume(after.volume, expected)) << "node " << i << (is_heaviest ? " (refitted)" : "");
+            EXPECT_TRUE(test_support::same_volume(after.volume, expected)) << "node " << i << (is_heaviest ? " (refitted)" : "");
             if (is_heaviest && policy.weighted_volume(after.volume) < policy.weighted_volume(before.volume)) ++improved;
         }
         expect_tree_properties(primitives, refined);
@@ -101,7 +91,7 @@ TEST(Fast, NodesOverTheCapAreNotRefitted) {
     const Bvh capped = fast(primitives, VolumePolicy::all(), {.exact_fits = 1000, .exact_fit_max_primitives = 3});
     std::uint32_t refitted = 0;
     for (std::uint32_t i = 0; i < cheap.nodes.size(); ++i) {
-        const bool same = identical_volume(cheap.nodes[i].volume, capped.nodes[i].volume);
+        const bool same = test_support::same_volume(cheap.nodes[i].volume, capped.nodes[i].volume);
         if (covered_primitives(cheap, i).size() > 3) {
             EXPECT_TRUE(same) << "node " << i << " over more than 3 primitives was refitted";
         } else if (!same) {

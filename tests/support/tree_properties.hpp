@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "hbvh/geometry/bounding_volume.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/bvh.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -45,6 +46,29 @@ inline void expect_tree_properties(const std::vector<Primitive>& primitives, con
     for (std::size_t p = 0; p < seen.size(); ++p) EXPECT_EQ(seen[p], 1) << "primitive " << p;
     const Status valid = validate(bvh);
     EXPECT_TRUE(valid.has_value()) << (valid.has_value() ? "" : valid.error().to_string());
+}
+
+/// The same kind with bit-identical numbers, field by field (-0 and +0 compare equal, NaN never does).
+inline bool same_volume(const BoundingVolume& a, const BoundingVolume& b) {
+    if (a.index() != b.index()) return false;
+    return std::visit(Overloaded{[&](const Aabb& x) {
+                                     const auto& y = std::get<Aabb>(b);
+                                     return x.min == y.min && x.max == y.max;
+                                 },
+                                 [&](const Obb& x) {
+                                     const auto& y = std::get<Obb>(b);
+                                     return x.center == y.center && x.rotation == y.rotation &&
+                                            x.half_extents == y.half_extents;
+                                 },
+                                 [&](const Sphere& x) {
+                                     const auto& y = std::get<Sphere>(b);
+                                     return x.center == y.center && x.radius == y.radius;
+                                 },
+                                 [&](const Capsule& x) {
+                                     const auto& y = std::get<Capsule>(b);
+                                     return x.p0 == y.p0 && x.p1 == y.p1 && x.radius == y.radius;
+                                 }},
+                      a);
 }
 
 /// The same tree node by node: structure, primitives, BV kinds and bit-identical BVs (what "deterministic for

@@ -20,6 +20,7 @@
 #include "hbvh/tree/binary_format.hpp"
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "support/tree_properties.hpp"
 
 namespace hbvh {
 namespace {
@@ -42,39 +43,17 @@ void reseal(std::string& bytes) {
     store_u64(bytes, at, crc64_xz(as_span(bytes).first(at)));
 }
 
-bool same_volume(const BoundingVolume& a, const BoundingVolume& b) {
-    if (a.index() != b.index()) return false;
-    return std::visit(Overloaded{[&](const Aabb& x) {
-                                     const auto& y = std::get<Aabb>(b);
-                                     return x.min == y.min && x.max == y.max;
-                                 },
-                                 [&](const Obb& x) {
-                                     const auto& y = std::get<Obb>(b);
-                                     return x.center == y.center && x.rotation == y.rotation &&
-                                            x.half_extents == y.half_extents;
-                                 },
-                                 [&](const Sphere& x) {
-                                     const auto& y = std::get<Sphere>(b);
-                                     return x.center == y.center && x.radius == y.radius;
-                                 },
-                                 [&](const Capsule& x) {
-                                     const auto& y = std::get<Capsule>(b);
-                                     return x.p0 == y.p0 && x.p1 == y.p1 && x.radius == y.radius;
-                                 }},
-                      a);
-}
-
 void expect_same(const Bvh& a, const Bvh& b) {
     ASSERT_EQ(a.nodes.size(), b.nodes.size());
     ASSERT_EQ(a.primitives.size(), b.primitives.size());
     for (std::size_t i = 0; i < a.nodes.size(); ++i) {
-        EXPECT_TRUE(same_volume(a.nodes[i].volume, b.nodes[i].volume)) << "node " << i;
+        EXPECT_TRUE(test_support::same_volume(a.nodes[i].volume, b.nodes[i].volume)) << "node " << i;
         EXPECT_EQ(a.nodes[i].first_child, b.nodes[i].first_child) << "node " << i;
         EXPECT_EQ(a.nodes[i].child_count, b.nodes[i].child_count) << "node " << i;
         EXPECT_EQ(a.nodes[i].primitive, b.nodes[i].primitive) << "node " << i;
     }
     for (std::size_t i = 0; i < a.primitives.size(); ++i) {
-        EXPECT_TRUE(same_volume(a.primitives[i].volume, b.primitives[i].volume)) << "primitive " << i;
+        EXPECT_TRUE(test_support::same_volume(a.primitives[i].volume, b.primitives[i].volume)) << "primitive " << i;
         EXPECT_EQ(a.primitives[i].name, b.primitives[i].name) << "primitive " << i;
     }
 }
