@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
-// Convex hull of sphere centres through qhull's reentrant C API, and the hull-surface covariance.
+// Convex hull of sphere centres (our quickhull for small sets, qhull for the rest), and the hull-surface covariance.
 #include "convex_hull.hpp"
+#include "quickhull.hpp"
 
 #include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <utility>
 
 extern "C" {
@@ -74,31 +76,48 @@ Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint
     return covariance / static_cast<double>(count);
 }
 
-HullSummary summarize_hull(std::span<const Sphere> spheres) {
+namespace {
+
+/// The summary of a hull given as triangles over `points` (the centred centres).
+HullSummary summary_of_triangles(std::span<const Vec3> points, const TriangleHull& hull) {
+    HullSummary summary;
+    double area_sum = 0.0;
+    Vec3 weighted_centroid = Vec3::Zero();
+    Mat3 second_moment = Mat3::Zero();
+    std::vector<std::pair<double, Vec3>> faces;
+    faces.reserve(hull.triangles.size());
+    for (const auto& [a, b, c] : hull.triangles) {
+        const Vec3& p = points[a];
+        const Vec3& q = points[b];
+        const Vec3& r = points[c];
+        const double area = add_triangle(p, q, r, area_sum, weighted_centroid, second_moment);
+        const Vec3 normal = (q - p).cross(r - p);
+        if (area > 0.0 && normal.norm() > 0.0) faces.emplace_back(area, normal.normalized());
+    }
+    if (!(area_sum > 0.0)) return summary;
+    summary.vertices = hull.vertices;
+    const Vec3 hull_centroid = weighted_centroid / area_sum;
+    summary.covariance = second_moment / area_sum - hull_centroid * hull_centroid.transpose();
+    summary.face_normals = distinct_normals(std::move(faces));
+    summary.is_solid = true;
+    return summary;
+}
+
+/// The summary by qhull; not solid when qhull finds no 3-D hull.
+HullSummary summary_by_qhull(std::span<const Vec3> points) {
     HullSummary summary;
     FILE* sink = null_sink();
-    // Fewer than four points cannot span a solid; qhull would only report an error.
-    if (spheres.size() < 4 || sink == nullptr) {
-        summary.vertices = all_indices(spheres.size());
-        summary.covariance = point_covariance(spheres);
-        return summary;
-    }
-
-    // Centre the points first: qhull's precision thresholds are relative to the largest coordinate, so a
-    // small cluster far from the origin (1e6 away) would otherwise look flat.
-    Vec3 mean = Vec3::Zero();
-    for (const Sphere& s : spheres) mean += s.center;
-    mean /= static_cast<double>(spheres.size());
-    std::vector<coordT> coordinates(3 * spheres.size());
-    for (std::size_t i = 0; i < spheres.size(); ++i)
-        for (int k = 0; k < 3; ++k) coordinates[3 * i + static_cast<std::size_t>(k)] = spheres[i].center[k] - mean[k];
+    if (sink == nullptr) return summary;
+    std::vector<coordT> coordinates(3 * points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+        for (int k = 0; k < 3; ++k) coordinates[3 * i + static_cast<std::size_t>(k)] = points[i][k];
 
     auto state = std::make_unique<qhT>();
     qhT* qh = state.get();
     qh_zero(qh, sink);
     // 'Qt' triangulates merged facets so that every facet is a triangle for the area weighting.
     char command[] = "qhull Qt";
-    const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(spheres.size()), coordinates.data(), False, command,
+    const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coordinates.data(), False, command,
                                        nullptr, sink);
     if (exit_code == 0) {
         double area_sum = 0.0;
@@ -125,7 +144,7 @@ HullSummary summarize_hull(std::span<const Sphere> spheres) {
         vertexT* vertex = nullptr;
         FORALLvertices {
             const int id = qh_pointid(qh, vertex->point);
-            if (id >= 0 && static_cast<std::size_t>(id) < spheres.size())
+            if (id >= 0 && static_cast<std::size_t>(id) < points.size())
                 summary.vertices.push_back(static_cast<std::uint32_t>(id));
         }
         if (area_sum > 0.0 && summary.vertices.size() >= 4) {
@@ -139,9 +158,32 @@ HullSummary summarize_hull(std::span<const Sphere> spheres) {
     int current_long = 0;
     int total_long = 0;
     qh_memfreeshort(qh, &current_long, &total_long);
+    return summary;
+}
 
+}  // namespace
+
+HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method) {
+    HullSummary summary;
+    // Fewer than four points cannot span a solid.
+    if (spheres.size() >= 4) {
+        // Centre the points first: precision thresholds (ours and qhull's) are relative to the largest
+        // coordinate, so a small cluster far from the origin (1e6 away) would otherwise look flat.
+        Vec3 mean = Vec3::Zero();
+        for (const Sphere& s : spheres) mean += s.center;
+        mean /= static_cast<double>(spheres.size());
+        std::vector<Vec3> points;
+        points.reserve(spheres.size());
+        for (const Sphere& s : spheres) points.push_back(s.center - mean);
+        // Small sets by our own quickhull, which returns nothing whenever rounding could mislead it;
+        // qhull, with its facet merging, takes those and the large sets.
+        std::optional<TriangleHull> triangles;
+        if (method == HullMethod::automatic && points.size() <= quickhull_max_points) triangles = quickhull(points);
+        summary = triangles ? summary_of_triangles(points, *triangles) : summary_by_qhull(points);
+    }
     if (!summary.is_solid) {
-        // Flat boxes, collinear points, duplicates: qhull refuses a 3-D hull, so use the raw centres.
+        // Flat boxes, collinear points, duplicates: no 3-D hull, so use the raw centres.
+        summary = HullSummary{};
         summary.vertices = all_indices(spheres.size());
         summary.covariance = point_covariance(spheres);
     }

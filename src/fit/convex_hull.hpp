@@ -24,13 +24,18 @@ struct HullSummary {
     /// Unit outward normals of the hull's faces, largest face first, near-duplicates (the triangles of one
     /// flat face) merged, at most max_face_normals. Empty when the hull is degenerate.
     std::vector<Vec3> face_normals;
-    /// True when qhull produced a full-dimensional hull with positive surface area.
+    /// True when the hull is full-dimensional with positive surface area.
     bool is_solid = false;
 };
 
+/// Who computes the hull: `automatic` is our quickhull (quickhull.hpp) for sets of up to quickhull_max_points,
+/// qhull for larger ones and for any set the quickhull declines; `qhull` is qhull alone, the reference the
+/// tests and benchmarks hold the quickhull path to.
+enum class HullMethod { automatic, qhull };
+
 /// Convex hull of the centres of `spheres` (radii are ignored). Never prints, never throws.
 /// Precondition: spheres non-empty.
-[[nodiscard]] HullSummary summarize_hull(std::span<const Sphere> spheres);
+[[nodiscard]] HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method = HullMethod::automatic);
 
 /// Covariance of the centres of `spheres[indices]` (all spheres when `indices` is empty), equally weighted.
 [[nodiscard]] Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint32_t> indices = {});

@@ -1,0 +1,34 @@
+// SPDX-License-Identifier: MIT
+// Internal: a triangulated 3-D convex hull of a small point set, without qhull's per-call set-up.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "hbvh/geometry/vector.hpp"
+
+namespace hbvh::detail {
+
+/// Inputs larger than this go to qhull: the hull below is quadratic in the worst case, and qhull's
+/// set-up, which dominates small calls, is nothing beside a large one (docs/fitting.md, "Own hull").
+inline constexpr std::size_t quickhull_max_points = 1024;
+
+/// A closed triangulated convex surface: every triangle counter-clockwise seen from outside.
+struct TriangleHull {
+    std::vector<std::array<std::uint32_t, 3>> triangles;  ///< Indices into the input points.
+    std::vector<std::uint32_t> vertices;                  ///< The triangles' corners, ascending, each once.
+};
+
+/// Quickhull (Barber, Dobkin & Huhdanpaa 1996) in double arithmetic, triangles only (no facet merging).
+/// A point counts as outside a face only when it is more than a tolerance (1e-12 of the points' largest
+/// |x|+|y|+|z|) above the face's plane, so points on or within rounding of the surface are not vertices,
+/// as in qhull. Returns nothing when the points span no solid (coincident, collinear or coplanar within
+/// that tolerance) or when rounding made a step inconsistent (a visible region whose horizon is not one
+/// loop, a sliver triangle, a surface that is not a closed triangulated sphere): the caller then asks qhull,
+/// which merges facets to handle exactly those cases. Every returned hull has passed those checks.
+[[nodiscard]] std::optional<TriangleHull> quickhull(std::span<const Vec3> points);
+
+}  // namespace hbvh::detail
