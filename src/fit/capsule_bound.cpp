@@ -115,19 +115,13 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
     // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
     double radius = max_radius;
-    std::vector<Eigen::Vector2d> projected;
     std::vector<Eigen::Vector2d> hull;
     std::vector<EdgeExtremes> extremes;
-    projected.reserve(proxy.hull_points.size());
+    OutlineScratch scratch;
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
             const Mat3 basis = frame_from_axis(frame * local_normal);
-            projected.clear();
-            for (const Vec3& p : proxy.hull_points) {
-                const Vec3 d = p - origin;
-                projected.emplace_back(d.dot(basis.col(1)), d.dot(basis.col(2)));
-            }
-            hull_2d(projected, hull);
+            hull_outline(proxy, basis, origin, hull, scratch);
             radius = std::max(radius, 0.5 * min_width(hull, extremes) + min_radius);
             // The bound only grows from here; once it is enough the other planes cannot change the answer.
             if (volume_at(radius) >= enough) return volume_at(radius);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -62,6 +63,41 @@ std::vector<std::uint32_t> all_indices(std::size_t n) {
 
 }  // namespace
 
+bool outline_along(const HullSurface& surface, const Vec3& direction, std::vector<std::uint32_t>& outline,
+                   std::vector<std::uint32_t>& next_slot) {
+    outline.clear();
+    if (surface.empty()) return false;
+    constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+    // Slots are 0..V-1 and F = 2V - 4, so V = F / 2 + 2.
+    next_slot.assign(surface.triangles.size() / 2 + 2, none);
+    // Faces parallel to the direction (a box's sides, seen along its face normal) have n.d = 0 up to rounding;
+    // taking either sign would let the loop cross such a face diagonally, back and forth in projection. So
+    // they count as turned away: they project to slivers at most 1e-9 of their size wide.
+    const double parallel = 1e-9 * direction.norm();
+    const auto faces = [&](std::uint32_t t) { return surface.normals[t].dot(direction) > parallel; };
+    std::size_t edges = 0;
+    std::uint32_t start = none;
+    for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
+        if (!faces(t)) continue;
+        for (std::size_t k = 0; k < 3; ++k) {
+            if (faces(surface.neighbors[t][k])) continue;
+            const std::uint32_t from = surface.triangles[t][k];
+            if (next_slot[from] != none) return false;  // two outline edges leave one vertex: not one loop
+            next_slot[from] = surface.triangles[t][(k + 1) % 3];
+            start = from;
+            ++edges;
+        }
+    }
+    if (start == none) return false;
+    for (std::uint32_t v = start; outline.size() <= edges;) {
+        outline.push_back(v);
+        v = next_slot[v];
+        if (v == none) return false;
+        if (v == start) break;
+    }
+    return outline.size() == edges;  // the walk closed after every outline edge: one simple loop
+}
+
 Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint32_t> indices) {
     const std::size_t count = indices.empty() ? spheres.size() : indices.size();
     auto at = [&](std::size_t i) -> const Vec3& { return spheres[indices.empty() ? i : indices[i]].center; };
@@ -86,15 +122,21 @@ HullSummary summary_of_triangles(std::span<const Vec3> points, const TriangleHul
     Mat3 second_moment = Mat3::Zero();
     std::vector<std::pair<double, Vec3>> faces;
     faces.reserve(hull.triangles.size());
+    std::vector<std::uint32_t> slot_of(points.size(), 0);
+    for (std::uint32_t slot = 0; slot < hull.vertices.size(); ++slot) slot_of[hull.vertices[slot]] = slot;
+    HullSurface& surface = summary.surface;
+    surface.neighbors = hull.neighbors;
     for (const auto& [a, b, c] : hull.triangles) {
         const Vec3& p = points[a];
         const Vec3& q = points[b];
         const Vec3& r = points[c];
         const double area = add_triangle(p, q, r, area_sum, weighted_centroid, second_moment);
-        const Vec3 normal = (q - p).cross(r - p);
-        if (area > 0.0 && normal.norm() > 0.0) faces.emplace_back(area, normal.normalized());
+        const Vec3 normal = (q - p).cross(r - p).normalized();
+        if (area > 0.0) faces.emplace_back(area, normal);
+        surface.triangles.push_back({slot_of[a], slot_of[b], slot_of[c]});
+        surface.normals.push_back(normal);
     }
-    if (!(area_sum > 0.0)) return summary;
+    if (!(area_sum > 0.0)) return HullSummary{};
     summary.vertices = hull.vertices;
     const Vec3 hull_centroid = weighted_centroid / area_sum;
     summary.covariance = second_moment / area_sum - hull_centroid * hull_centroid.transpose();

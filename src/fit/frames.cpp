@@ -165,8 +165,29 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     return frames;
 }
 
+void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origin, std::vector<Eigen::Vector2d>& hull,
+                  OutlineScratch& scratch) {
+    const auto project = [&](const Vec3& p) {
+        const Vec3 d = p - origin;
+        return Eigen::Vector2d(d.dot(basis.col(1)), d.dot(basis.col(2)));
+    };
+    if (outline_along(proxy.surface, basis.col(0), scratch.outline, scratch.next_slot) &&
+        scratch.outline.size() <= calipers_above) {
+        hull.clear();
+        for (std::uint32_t slot : scratch.outline) hull.push_back(project(proxy.hull_points[slot]));
+        return;
+    }
+    std::vector<Eigen::Vector2d>& projected = scratch.projected;
+    // Every centre lies in the hull of the hull-vertex centres, so their projections span the same 2-D hull:
+    // sorting only those keeps this O(hull size) per call even when many spheres are kept.
+    projected.clear();
+    for (const Vec3& p : proxy.hull_points) projected.push_back(project(p));
+    hull_2d(projected, hull);
+}
+
 SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull) {
     SphereProxy proxy;
+    proxy.surface = hull.surface;
     std::vector<bool> taken(spheres.size(), false);
     for (std::uint32_t i : hull.vertices) {
         taken[i] = true;
@@ -208,17 +229,12 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     std::vector<Mat3> frames;
     frames.reserve(normals.size());
     const double pad = 2.0 * proxy.max_radius;
-    std::vector<Eigen::Vector2d> projected;
+    OutlineScratch scratch;
     std::vector<Eigen::Vector2d> hull;
     std::vector<EdgeExtremes> extremes;
-    projected.reserve(proxy.hull_points.size());
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
-        // Every centre lies in the hull of the hull-vertex centres, so their projections span the same
-        // 2-D hull: sorting only those keeps this O(hull size) per normal even when many spheres are kept.
-        projected.clear();
-        for (const Vec3& p : proxy.hull_points) projected.emplace_back(p.dot(basis.col(1)), p.dot(basis.col(2)));
-        hull_2d(projected, hull);
+        hull_outline(proxy, basis, Vec3::Zero(), hull, scratch);
         // Try each hull edge as a rectangle side: over every vertex for small hulls (O(h^2), exact), by
         // rotating calipers above (O(h); a flat ring of 10^5 spheres projects to a 2-D hull of 10^5 points).
         const bool brute_force = hull.size() <= calipers_above;

@@ -18,6 +18,7 @@ namespace hbvh::detail {
 struct SphereProxy {
     std::vector<Sphere> spheres;
     std::vector<Vec3> hull_points;  ///< Centres of the hull vertices only: a cheaper, coarser stand-in.
+    HullSurface surface;            ///< The hull's surface over hull_points (empty when qhull made the hull).
     double max_radius = 0.0;
 };
 
@@ -50,11 +51,25 @@ inline constexpr std::size_t max_ranked_hints = 8;
 [[nodiscard]] std::vector<Mat3> dito_frames(std::span<const Sphere> spheres);
 
 /// For each unit `normals[i]`, the frame with column 0 along it whose cross-section is the smallest
-/// rectangle around the projected hull points (padded by the largest radius): the rectangle has a side along an edge of the projected 2-D
-/// hull (Freeman & Shapira 1975), so the edges are the only directions tried. With the hull's face
+/// rectangle around the projected hull points (padded by the largest radius): the rectangle has a side along
+/// an edge of the projected 2-D hull (Freeman & Shapira 1975), so the edges are the only directions tried.
+/// The projected hull is the proxy's surface outline along the normal where it has one (hull_outline). With the hull's face
 /// normals this gives boxes with a face flush with a hull face: a heuristic in the spirit of O'Rourke
 /// 1985 (whose minimal box has two adjacent faces each containing a hull edge), not a guarantee.
 [[nodiscard]] std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals);
+
+/// The 2-D hull of the proxy's hull points projected on (basis.col(1), basis.col(2)) after subtracting
+/// `origin`, into `hull`: the projected outline of the proxy's surface along basis.col(0) when it has one of at
+/// most calipers_above points (its points lie on the polygon's boundary, perhaps with some on its edges, which
+/// the brute-force rectangle and width searches tolerate), else hull_2d of every projected point, counter-clockwise.
+/// `scratch` is reused across calls, so that loops over many planes allocate once.
+struct OutlineScratch {
+    std::vector<Eigen::Vector2d> projected;
+    std::vector<std::uint32_t> outline;
+    std::vector<std::uint32_t> next_slot;
+};
+void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origin, std::vector<Eigen::Vector2d>& hull,
+                  OutlineScratch& scratch);
 
 /// The smallest box with axes `rotation` containing every sphere exactly (in double arithmetic:
 /// Obb::contains with zero tolerance holds for each input). O(n).

@@ -232,13 +232,21 @@ private:
     /// The live faces as a TriangleHull, after checking that they close up as a triangulated sphere.
     std::optional<TriangleHull> finish() {
         TriangleHull hull;
+        std::vector<std::uint32_t> output_index(faces_.size(), none);
         for (std::uint32_t f = 0; f < faces_.size(); ++f) {
-            const Face& face = faces_[f];
-            if (!face.alive) continue;
-            for (std::uint32_t other : face.neighbor)
-                if (!faces_[other].alive) return std::nullopt;
-            hull.triangles.push_back(face.vertex);
-            for (std::uint32_t v : face.vertex) hull.vertices.push_back(v);
+            if (!faces_[f].alive) continue;
+            output_index[f] = static_cast<std::uint32_t>(hull.triangles.size());
+            hull.triangles.push_back(faces_[f].vertex);
+            for (std::uint32_t v : faces_[f].vertex) hull.vertices.push_back(v);
+        }
+        for (std::uint32_t f = 0; f < faces_.size(); ++f) {
+            if (!faces_[f].alive) continue;
+            std::array<std::uint32_t, 3> across{};
+            for (std::size_t k = 0; k < 3; ++k) {
+                across[k] = output_index[faces_[f].neighbor[k]];
+                if (across[k] == none) return std::nullopt;  // linked to a deleted face
+            }
+            hull.neighbors.push_back(across);
         }
         std::sort(hull.vertices.begin(), hull.vertices.end());
         hull.vertices.erase(std::unique(hull.vertices.begin(), hull.vertices.end()), hull.vertices.end());

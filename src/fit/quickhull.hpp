@@ -19,6 +19,7 @@ inline constexpr std::size_t quickhull_max_points = 1024;
 /// A closed triangulated convex surface: every triangle counter-clockwise seen from outside.
 struct TriangleHull {
     std::vector<std::array<std::uint32_t, 3>> triangles;  ///< Indices into the input points.
+    std::vector<std::array<std::uint32_t, 3>> neighbors;  ///< neighbors[t][k]: the triangle across t's edge k.
     std::vector<std::uint32_t> vertices;                  ///< The triangles' corners, ascending, each once.
 };
 

@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <set>
@@ -15,6 +16,8 @@
 #include <vector>
 
 #include "../../src/fit/convex_hull.hpp"
+#include "../../src/fit/frames.hpp"
+#include "../../src/fit/hull_2d.hpp"
 #include "../../src/fit/quickhull.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -200,6 +203,66 @@ TEST(Quickhull, RepeatedAndInteriorPointsAreNoVertices) {
     EXPECT_EQ(hull->triangles.size(), 12u);
     for (std::uint32_t v : hull->vertices) EXPECT_EQ(points[v].cwiseAbs(), Vec3::Ones());
     expect_hull_of(points, *hull, 1e-12, "cube");
+}
+
+/// How far `q` lies outside the convex polygon `corners` (either orientation; repeated and collinear corners
+/// allowed): the largest distance beyond an edge's line, so 0 on the boundary and negative inside.
+double boundary_distance(std::vector<Eigen::Vector2d> corners, const Eigen::Vector2d& q) {
+    double area = 0.0;
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+        const Eigen::Vector2d& a = corners[i];
+        const Eigen::Vector2d& b = corners[(i + 1) % corners.size()];
+        area += a.x() * b.y() - a.y() * b.x();
+    }
+    if (area < 0.0) std::reverse(corners.begin(), corners.end());
+    double outside = -std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < corners.size(); ++i) {
+        const Eigen::Vector2d edge = corners[(i + 1) % corners.size()] - corners[i];
+        if (!(edge.norm() > 0.0)) continue;
+        outside = std::max(outside, Eigen::Vector2d(edge.y(), -edge.x()).normalized().dot(q - corners[i]));
+    }
+    return outside;
+}
+
+TEST(HullOutline, SamePolygonAsTheSortedHullOfTheProjection) {
+    // Directions: random ones, the world axes and every face normal (faces parallel to the direction are
+    // then exactly or nearly perpendicular to it: the case rounding can make ambiguous).
+    SplitMix64 rng(77);
+    int outlines = 0, attempts = 0;
+    for (const auto& [name, points] : solid_sets()) {
+        const std::vector<Sphere> spheres = as_spheres(points);
+        const detail::HullSummary hull = detail::summarize_hull(spheres);
+        if (!hull.is_solid) continue;
+        ASSERT_FALSE(hull.surface.empty()) << name;
+        std::vector<Vec3> directions{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
+        for (int i = 0; i < 5; ++i) directions.push_back(rng.rotation().col(0));
+        for (const Vec3& n : hull.face_normals) directions.push_back(n);
+        std::vector<std::uint32_t> outline, next_slot;
+        for (const Vec3& direction : directions) {
+            ++attempts;
+            if (!detail::outline_along(hull.surface, direction, outline, next_slot)) continue;
+            ++outlines;
+            const Mat3 basis = detail::frame_from_axis(direction);
+            const auto project = [&](std::uint32_t input) {
+                return Eigen::Vector2d(points[input].dot(basis.col(1)), points[input].dot(basis.col(2)));
+            };
+            std::vector<Eigen::Vector2d> projected, reference;
+            for (const Vec3& p : points) projected.emplace_back(p.dot(basis.col(1)), p.dot(basis.col(2)));
+            detail::hull_2d(projected, reference);
+            std::vector<Eigen::Vector2d> loop;
+            for (std::uint32_t slot : outline) loop.push_back(project(hull.vertices[slot]));
+            const double slack = 1e-9 * scale_of(points);
+            // The same convex polygon: every corner of each lies on the other's boundary.
+            for (const Eigen::Vector2d& corner : reference) {
+                EXPECT_LE(std::abs(boundary_distance(loop, corner)), slack) << name << ": a corner off the outline";
+            }
+            for (const Eigen::Vector2d& q : loop) {
+                EXPECT_LE(std::abs(boundary_distance(reference, q)), slack) << name << ": an outline point off the hull";
+            }
+        }
+    }
+    // Declining is for rounding ambiguity only, which none of these sets and directions has.
+    EXPECT_EQ(outlines, attempts) << outlines << " of " << attempts;
 }
 
 }  // namespace
