@@ -63,24 +63,28 @@ std::vector<std::uint32_t> all_indices(std::size_t n) {
 
 }  // namespace
 
-bool outline_along(const HullSurface& surface, const Vec3& direction, std::vector<std::uint32_t>& outline,
-                   std::vector<std::uint32_t>& next_slot) {
+bool outline_along(const HullSurface& surface, const Vec3& direction, OutlineScratch& scratch) {
+    std::vector<std::uint32_t>& outline = scratch.outline;
     outline.clear();
     if (surface.empty()) return false;
     constexpr std::uint32_t none = std::numeric_limits<std::uint32_t>::max();
+    const std::size_t triangle_count = surface.triangles.size();
     // Slots are 0..V-1 and F = 2V - 4, so V = F / 2 + 2.
-    next_slot.assign(surface.triangles.size() / 2 + 2, none);
+    std::vector<std::uint32_t>& next_slot = scratch.next_slot;
+    next_slot.assign(triangle_count / 2 + 2, none);
     // Faces parallel to the direction (a box's sides, seen along its face normal) have n.d = 0 up to rounding;
     // taking either sign would let the loop cross such a face diagonally, back and forth in projection. So
     // they count as turned away: they project to slivers at most 1e-9 of their size wide.
     const double parallel = 1e-9 * direction.norm();
-    const auto faces = [&](std::uint32_t t) { return surface.normals[t].dot(direction) > parallel; };
+    std::vector<unsigned char>& facing = scratch.facing;
+    facing.resize(triangle_count);
+    for (std::size_t t = 0; t < triangle_count; ++t) facing[t] = surface.normals[t].dot(direction) > parallel ? 1 : 0;
     std::size_t edges = 0;
     std::uint32_t start = none;
-    for (std::uint32_t t = 0; t < surface.triangles.size(); ++t) {
-        if (!faces(t)) continue;
+    for (std::size_t t = 0; t < triangle_count; ++t) {
+        if (facing[t] == 0) continue;
         for (std::size_t k = 0; k < 3; ++k) {
-            if (faces(surface.neighbors[t][k])) continue;
+            if (facing[surface.neighbors[t][k]] != 0) continue;
             const std::uint32_t from = surface.triangles[t][k];
             if (next_slot[from] != none) return false;  // two outline edges leave one vertex: not one loop
             next_slot[from] = surface.triangles[t][(k + 1) % 3];

@@ -50,15 +50,22 @@ enum class HullMethod { automatic, qhull };
 /// Precondition: spheres non-empty.
 [[nodiscard]] HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method = HullMethod::automatic);
 
-/// The outline of `surface` seen along `direction`: the loop of edges between the triangles that face
-/// `direction` and those that do not (faces within 1e-9 of parallel to it count as not facing it), as slots
-/// in order around it. Its points project onto the polygon that
-/// bounds the hull's projection (points on the polygon's edges included), so the 2-D hull of the projected
-/// vertices need not be sorted out: O(triangles) and no sort. False when the surface is empty or when rounding
-/// made the loop not simple (a face nearly parallel to `direction` classified against its neighbours):
-/// callers then project every vertex and take hull_2d. `next_slot` is scratch, reused across calls.
-[[nodiscard]] bool outline_along(const HullSurface& surface, const Vec3& direction, std::vector<std::uint32_t>& outline,
-                                 std::vector<std::uint32_t>& next_slot);
+/// Scratch of outline_along, reused across calls so that loops over many directions allocate once.
+struct OutlineScratch {
+    std::vector<std::uint32_t> outline;    ///< The result: slots in order around the outline.
+    std::vector<std::uint32_t> next_slot;  ///< Per slot, the next one along the outline.
+    std::vector<unsigned char> facing;     ///< Per triangle, whether it faces the direction.
+    std::vector<Eigen::Vector2d> projected;
+};
+
+/// The outline of `surface` seen along `direction`, into scratch.outline: the loop of edges between the
+/// triangles that face `direction` and those that do not (faces within 1e-9 of parallel to it count as not
+/// facing it), as slots in order around it. Its points project onto the polygon that bounds the hull's
+/// projection (points on the polygon's edges included), so the 2-D hull of the projected vertices need not
+/// be sorted out: O(triangles) and no sort. False when the surface is empty or when rounding made the loop
+/// not simple (a face nearly parallel to `direction` classified against its neighbours): callers then
+/// project every vertex and take hull_2d.
+[[nodiscard]] bool outline_along(const HullSurface& surface, const Vec3& direction, OutlineScratch& scratch);
 
 /// Covariance of the centres of `spheres[indices]` (all spheres when `indices` is empty), equally weighted.
 [[nodiscard]] Mat3 point_covariance(std::span<const Sphere> spheres, std::span<const std::uint32_t> indices = {});

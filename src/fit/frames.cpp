@@ -171,8 +171,7 @@ void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origi
         const Vec3 d = p - origin;
         return Eigen::Vector2d(d.dot(basis.col(1)), d.dot(basis.col(2)));
     };
-    if (outline_along(proxy.surface, basis.col(0), scratch.outline, scratch.next_slot) &&
-        scratch.outline.size() <= calipers_above) {
+    if (outline_along(proxy.surface, basis.col(0), scratch) && scratch.outline.size() <= calipers_above) {
         hull.clear();
         for (std::uint32_t slot : scratch.outline) hull.push_back(project(proxy.hull_points[slot]));
         return;

@@ -63,11 +63,6 @@ inline constexpr std::size_t max_ranked_hints = 8;
 /// most calipers_above points (its points lie on the polygon's boundary, perhaps with some on its edges, which
 /// the brute-force rectangle and width searches tolerate), else hull_2d of every projected point, counter-clockwise.
 /// `scratch` is reused across calls, so that loops over many planes allocate once.
-struct OutlineScratch {
-    std::vector<Eigen::Vector2d> projected;
-    std::vector<std::uint32_t> outline;
-    std::vector<std::uint32_t> next_slot;
-};
 void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origin, std::vector<Eigen::Vector2d>& hull,
                   OutlineScratch& scratch);
 

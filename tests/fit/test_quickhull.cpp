@@ -237,10 +237,11 @@ TEST(HullOutline, SamePolygonAsTheSortedHullOfTheProjection) {
         std::vector<Vec3> directions{Vec3::UnitX(), Vec3::UnitY(), Vec3::UnitZ()};
         for (int i = 0; i < 5; ++i) directions.push_back(rng.rotation().col(0));
         for (const Vec3& n : hull.face_normals) directions.push_back(n);
-        std::vector<std::uint32_t> outline, next_slot;
+        detail::OutlineScratch scratch;
+        const std::vector<std::uint32_t>& outline = scratch.outline;
         for (const Vec3& direction : directions) {
             ++attempts;
-            if (!detail::outline_along(hull.surface, direction, outline, next_slot)) continue;
+            if (!detail::outline_along(hull.surface, direction, scratch)) continue;
             ++outlines;
             const Mat3 basis = detail::frame_from_axis(direction);
             const auto project = [&](std::uint32_t input) {
