@@ -13,10 +13,15 @@
 #include "frames.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "capsule_segment.hpp"
 #include "min_circle.hpp"
 
 namespace hbvh {
 namespace {
+
+using detail::AxisDistances;
+using detail::keep_end_candidates;
+using detail::segment_for_radius;
 
 /// The spheres in a frame whose column 0 is the capsule axis: axial coordinate and 2-D cross-section.
 struct Projected {
@@ -35,48 +40,6 @@ void project(std::span<const Sphere> spheres, const Mat3& frame, Projected& p) {
     }
 }
 
-/// Per-sphere numbers the radius search reads: axial coordinate, own radius and squared distance from the
-/// axis line, computed once per direction as plain arrays (the search reads them ~30 times per direction).
-struct AxisDistances {
-    std::vector<double> axial;
-    std::vector<double> radius;
-    std::vector<double> distance_squared;
-};
-
-/// The shortest segment [t0, t1] on the axis line for capsule radius `radius`. Sphere i (distance d_i from
-/// the line) is inside iff its centre is within radius - r_i of the segment, i.e. the segment reaches within
-/// h_i = sqrt((radius - r_i)^2 - d_i^2) of t_i along the axis: t0 <= t_i + h_i and t1 >= t_i - h_i. So
-/// t0 = min(t_i + h_i), t1 = max(t_i - h_i); when t1 < t0 any single point of [t1, t0] works and the capsule
-/// is a sphere.
-std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
-    // Two spheres per step in SSE2 lanes (this loop is the capsule fitter's inner loop). min and max are
-    // exact, so the lanes' order changes no result.
-    using Pair = Eigen::Array2d;
-    const std::size_t count = a.axial.size();
-    const double* axial = a.axial.data();
-    const double* own = a.radius.data();
-    const double* d2 = a.distance_squared.data();
-    Pair low = Pair::Constant(std::numeric_limits<double>::infinity());
-    Pair high = Pair::Constant(-std::numeric_limits<double>::infinity());
-    std::size_t i = 0;
-    for (; i + 2 <= count; i += 2) {
-        const Pair slack = radius - Pair::Map(own + i);
-        const Pair h = (slack * slack - Pair::Map(d2 + i)).max(0.0).sqrt();
-        low = low.min(Pair::Map(axial + i) + h);
-        high = high.max(Pair::Map(axial + i) - h);
-    }
-    double t0 = std::min(low[0], low[1]);
-    double t1 = std::max(high[0], high[1]);
-    for (; i < count; ++i) {
-        const double slack = radius - own[i];
-        const double h = std::sqrt(std::max(0.0, slack * slack - d2[i]));
-        t0 = std::min(t0, axial[i] + h);
-        t1 = std::max(t1, axial[i] - h);
-    }
-    if (t1 < t0) t0 = t1 = 0.5 * (t0 + t1);
-    return {t0, t1};
-}
-
 double capsule_volume(double radius, double length) {
     return std::numbers::pi * radius * radius * length + 4.0 / 3.0 * std::numbers::pi * radius * radius * radius;
 }
@@ -86,6 +49,7 @@ double capsule_volume(double radius, double length) {
 struct CapsuleScratch {
     Projected projected;
     AxisDistances distances;
+    AxisDistances bracket;  ///< The spheres that can set an end inside the golden-section bracket.
 };
 
 /// A capsule along column 0 of `frame` (a proper rotation) around `spheres`.
@@ -120,49 +84,55 @@ Capsule capsule_along(std::span<const Sphere> spheres, const Mat3& frame, bool e
         min_radius = std::max(min_radius, distance + p.section[i].radius);
     }
 
-    auto volume_at = [&](double r) {
-        const auto [t0, t1] = segment_for_radius(distances, r);
+    auto volume_at = [](const AxisDistances& candidates, double r) {
+        const auto [t0, t1] = segment_for_radius(candidates, r);
         return capsule_volume(r, t1 - t0);
     };
     double radius = min_radius;
     const auto [first_t0, first_t1] = segment_for_radius(distances, min_radius);
     const double first_length = first_t1 - first_t0;
+    const AxisDistances* final_set = &distances;
     if (exact_line && first_length > 0.0) {
         // A fatter capsule can be shorter: the end caps then swallow spheres near the ends. Sample radii
-        // geometrically up to one length more, then golden-section search around the best sample.
+        // geometrically up to one length more, then golden-section search around the best sample. The search
+        // reads only the spheres that can set an end within its bracket (the same segments, bit for bit); over
+        // the samples' wide range nearly every sphere can, so they read all.
         std::array<double, 8> radii{min_radius};
         std::size_t sampled = 1;
         for (double g = 1.0 / 64.0; g <= 1.0; g *= 2.0) radii[sampled++] = min_radius + g * first_length;
         std::size_t best = 0;
-        double best_volume = volume_at(radii[0]);
+        double best_volume = volume_at(distances, radii[0]);
         for (std::size_t i = 1; i < sampled; ++i) {
-            const double v = volume_at(radii[i]);
+            const double v = volume_at(distances, radii[i]);
             if (v < best_volume) best = i, best_volume = v;
         }
         double a = radii[best == 0 ? 0 : best - 1];
         double b = radii[std::min(best + 1, sampled - 1)];
         radius = radii[best];
+        keep_end_candidates(distances, a, b, scratch.bracket);
+        const AxisDistances& bracket = scratch.bracket;
         const double ratio = (std::sqrt(5.0) - 1.0) / 2.0;
         double x1 = b - ratio * (b - a);
         double x2 = a + ratio * (b - a);
-        double f1 = volume_at(x1);
-        double f2 = volume_at(x2);
+        double f1 = volume_at(bracket, x1);
+        double f2 = volume_at(bracket, x2);
         // 16 steps shrink the bracket to 5e-4 of its width; near the optimum the volume is flat (quadratic),
         // so the remaining error is far below anything a builder could notice.
         for (int iteration = 0; iteration < 16; ++iteration) {
             if (f1 < f2) {
                 b = x2, x2 = x1, f2 = f1;
-                x1 = b - ratio * (b - a), f1 = volume_at(x1);
+                x1 = b - ratio * (b - a), f1 = volume_at(bracket, x1);
             } else {
                 a = x1, x1 = x2, f1 = f2;
-                x2 = a + ratio * (b - a), f2 = volume_at(x2);
+                x2 = a + ratio * (b - a), f2 = volume_at(bracket, x2);
             }
         }
         for (const auto& [x, f] : {std::pair{x1, f1}, std::pair{x2, f2}})
             if (f < best_volume) radius = x, best_volume = f;
+        final_set = &bracket;  // radius lies in the bracket: radii[best], x1 or x2
     }
 
-    const auto [t0, t1] = segment_for_radius(distances, radius);
+    const auto [t0, t1] = segment_for_radius(*final_set, radius);
     const Vec3 axis = frame.col(0);
     const Vec3 base = frame.col(1) * line.x() + frame.col(2) * line.y();
     return {base + t0 * axis, base + t1 * axis, radius};
