@@ -1,12 +1,14 @@
 // SPDX-License-Identifier: MIT
-// The speed preset: build_fast's time per build and its tree's Eq. 2 cost relative to auto's, for 0, 1, 2 and
-// 4 refitted nodes (FastOptions::exact_fits), on the bundled models and generated objects of 30 primitives.
-// The default of 2 is chosen from this table (docs/fast.md).
+// The speed preset: build_fast's time per build and its tree's Eq. 2 cost relative to auto's, without the quick
+// treelet sweep and with 4-6 units per treelet (FastOptions::treelet_units), and for 0, 1, 2 and 4 refitted
+// nodes (FastOptions::exact_fits), on the bundled models and generated objects of 30 primitives. The defaults
+// (4 units, 2 refits) are chosen from this table (docs/fast.md).
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "hbvh/builders/auto.hpp"
@@ -45,7 +47,7 @@ const FastObject& object_for(const std::string& name) {
     return object;
 }
 
-void fast_build(benchmark::State& state, const std::string& name, std::uint32_t exact_fits) {
+void fast_build(benchmark::State& state, const std::string& name, const FastOptions& options) {
     const FastObject& object = object_for(name);
     if (object.primitives.empty()) {
         state.SkipWithError(("cannot read data/models/" + name + ".xml").c_str());
@@ -54,7 +56,7 @@ void fast_build(benchmark::State& state, const std::string& name, std::uint32_t 
     const BuildContext context;
     double tree_cost = 0.0;
     for (auto _ : state) {
-        Result<Bvh> bvh = build_fast(object.primitives, context, {.exact_fits = exact_fits});
+        Result<Bvh> bvh = build_fast(object.primitives, context, options);
         tree_cost = cost(bvh.value());
         benchmark::DoNotOptimize(tree_cost);
     }
@@ -62,14 +64,22 @@ void fast_build(benchmark::State& state, const std::string& name, std::uint32_t 
     state.counters["cost_vs_auto"] = tree_cost / object.auto_cost;
 }
 
+/// Rows FastBuild/NAME/treelets:U/refits:R: U units per quick treelet (0: no sweep), R refitted nodes.
 void register_fast_benchmarks() {
+    constexpr std::uint32_t default_units = FastOptions{}.treelet_units;
+    const std::pair<std::uint32_t, std::uint32_t> settings[] = {{0, 2}, {default_units, 0}, {default_units, 1},
+                                                                {default_units, 2}, {default_units, 4}, {5, 2}, {6, 2}};
     for (const char* name : object_names)
-        for (const std::uint32_t exact_fits : {0u, 1u, 2u, 4u})
-            benchmark::RegisterBenchmark(("FastBuild/" + std::string(name) + "/" + std::to_string(exact_fits)).c_str(),
-                                         [name = std::string(name), exact_fits](benchmark::State& state) {
-                                             fast_build(state, name, exact_fits);
+        for (const auto& [units, refits] : settings) {
+            const FastOptions options{.treelet_units = units, .exact_fits = refits};
+            benchmark::RegisterBenchmark(("FastBuild/" + std::string(name) + "/treelets:" + std::to_string(units) +
+                                          "/refits:" + std::to_string(refits))
+                                             .c_str(),
+                                         [name = std::string(name), options](benchmark::State& state) {
+                                             fast_build(state, name, options);
                                          })
                 ->Unit(benchmark::kMillisecond);
+        }
 }
 
 /// Registers at static-initialisation time, before BENCHMARK_MAIN parses the command line.

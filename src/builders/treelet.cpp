@@ -24,6 +24,7 @@
 #include "optimal_plan.hpp"
 #include "treelet_fit_cache.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
@@ -40,11 +41,24 @@ struct Item {
 
 using Fitted = detail::TreeletFit;
 
+/// True when two hints give fit_fast the same candidate: boxes whose rotations agree to 1e-9 (their frame is
+/// all fit_fast takes from them), or the same capsule segment (fit_fast uses its line).
+bool same_frame(const BoundingVolume& a, const BoundingVolume& b) {
+    if (const Obb* box = std::get_if<Obb>(&a)) {
+        const Obb* other = std::get_if<Obb>(&b);
+        return other != nullptr && (box->rotation - other->rotation).cwiseAbs().maxCoeff() < 1e-9;
+    }
+    const Capsule* capsule = std::get_if<Capsule>(&a);
+    const Capsule* other = std::get_if<Capsule>(&b);
+    return capsule != nullptr && other != nullptr && capsule->p0 == other->p0 && capsule->p1 == other->p1;
+}
+
 class Refiner {
 public:
     Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
         : primitives_(bvh.primitives), policy_(policy),
-          max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits) {
+          max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits),
+          fitter_(cache.fitter()) {
         items_.reserve(bvh.nodes.size());
         for (const Node& node : bvh.nodes) {
             Item item{node.volume, {}, node.primitive};
@@ -79,6 +93,28 @@ public:
     [[nodiscard]] std::uint64_t fit_count() const { return fits_; }
 
 private:
+    /// The volume over the primitives of one covered set, by the cache's fitter.
+    [[nodiscard]] BoundingVolume fit_set(std::span<const std::uint32_t> set) const {
+        if (fitter_ == detail::TreeletFitter::quick) {
+            std::vector<Sphere> spheres;
+            std::vector<BoundingVolume> hints;
+            hints.reserve(set.size());
+            for (std::uint32_t p : set) {
+                const BoundingVolume& volume = primitives_[p].volume;
+                append_generating_spheres(volume, spheres);
+                if (!std::holds_alternative<Obb>(volume) && !std::holds_alternative<Capsule>(volume)) continue;
+                const bool repeat = std::any_of(hints.begin(), hints.end(), [&](const BoundingVolume& hint) {
+                    return same_frame(hint, volume);
+                });
+                if (!repeat) hints.push_back(volume);
+            }
+            return fit_fast(spheres, hints, policy_);
+        }
+        FitInput input;
+        for (std::uint32_t p : set) input.add(primitives_[p].volume);
+        return fit_best(input.spheres, policy_, input.hint_axes);
+    }
+
     [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {
         std::vector<std::uint32_t> out;
         std::vector<std::uint32_t> stack{id};
@@ -97,6 +133,7 @@ private:
     std::uint32_t max_units_;
     std::vector<Item> items_;
     std::unordered_map<std::vector<std::uint32_t>, Fitted, detail::CoveredSetHash>& cache_;
+    detail::TreeletFitter fitter_;
     std::uint64_t fits_ = 0;
 };
 
@@ -140,7 +177,7 @@ bool Refiner::refine_at(std::uint32_t root) {
         current += static_cast<double>(items_[*it].children.size()) * policy_.weighted_volume(items_[*it].volume);
     }
 
-    // Stage 3: fit_best over the primitives of every union of two or more units. Covered sets recur
+    // Stage 3: fit_best (or the quick fitter) over the primitives of every union of two or more units. Covered sets recur
     // across treelets, passes and (through a shared cache) refinements of other trees over the same
     // primitives, so fits are cached by set; the missing ones are fitted in parallel,
     // each depending on its set only, so the result does not depend on the thread count.
@@ -161,16 +198,14 @@ bool Refiner::refine_at(std::uint32_t root) {
             missing.emplace_back(mask, std::move(key));
     }
     std::vector<Fitted> fresh(missing.size());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), 4),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                          for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                              FitInput input;
-                              for (std::uint32_t p : missing[j].second) input.add(primitives_[p].volume);
-                              BoundingVolume bv = fit_best(input.spheres, policy_, input.hint_axes);
-                              fresh[j].weighted = policy_.weighted_volume(bv);
-                              fresh[j].volume = std::move(bv);
-                          }
-                      });
+    const auto fit_range = [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t j = range.begin(); j != range.end(); ++j) {
+            BoundingVolume bv = fit_set(missing[j].second);
+            fresh[j].weighted = policy_.weighted_volume(bv);
+            fresh[j].volume = std::move(bv);
+        }
+    };
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), 4), fit_range);
     fits_ += missing.size();
     for (std::size_t j = 0; j < missing.size(); ++j) {
         auto [it, inserted] = cache_.emplace(std::move(missing[j].second), std::move(fresh[j]));

@@ -33,14 +33,23 @@ struct CoveredSetHash {
 /// Fits by covered set (sorted input indices). A refinement's fit of a set depends on nothing but the set,
 /// the primitives and the policy, so sharing the cache between refinements of trees built over the same
 /// primitives (in input order, as every Bvh keeps them) under the same policy changes no result.
+/// Which fitter a refinement prices its subsets with.
+enum class TreeletFitter {
+    best,  ///< fit_best: the tightest volumes, about 0.05-0.2 ms per set of a few dozen primitives.
+    quick  ///< fit_fast over the set's spheres with its primitives as hints: microseconds, a little larger.
+};
+
 class TreeletFitCache {
 public:
-    explicit TreeletFitCache(std::size_t primitive_count) : primitive_count_(primitive_count) {}
+    explicit TreeletFitCache(std::size_t primitive_count, TreeletFitter fitter = TreeletFitter::best)
+        : primitive_count_(primitive_count), fitter_(fitter) {}
     [[nodiscard]] std::size_t primitive_count() const { return primitive_count_; }
+    [[nodiscard]] TreeletFitter fitter() const { return fitter_; }
     std::unordered_map<std::vector<std::uint32_t>, TreeletFit, CoveredSetHash> fits;
 
 private:
     std::size_t primitive_count_;
+    TreeletFitter fitter_;
 };
 
 /// refine_treelets with fits looked up in, and added to, `cache`. Precondition: every tree refined with

@@ -14,6 +14,7 @@
 #include "support/tree_properties.hpp"
 #include "hbvh/builders/fast.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
@@ -85,6 +86,74 @@ TEST(Fast, RefitsExactlyTheHeaviestNodesWithFitBestWhereCheaper) {
     EXPECT_GT(improved, 3u);
 }
 
+/// fit_fast over the primitives below `node` with the distinct box frames and capsules among them as hints,
+/// gathered here independently of the builder.
+BoundingVolume fit_fast_below(const Bvh& bvh, std::uint32_t node, const VolumePolicy& policy) {
+    std::vector<std::uint32_t> leaves = covered_primitives(bvh, node);
+    std::sort(leaves.begin(), leaves.end());
+    std::vector<Sphere> spheres;
+    std::vector<BoundingVolume> hints;
+    for (const std::uint32_t p : leaves) {
+        const BoundingVolume& volume = bvh.primitives[p].volume;
+        append_generating_spheres(volume, spheres);
+        bool seen = false;
+        for (const BoundingVolume& hint : hints) {
+            const Obb* a = std::get_if<Obb>(&hint);
+            const Obb* b = std::get_if<Obb>(&volume);
+            const Capsule* c = std::get_if<Capsule>(&hint);
+            const Capsule* d = std::get_if<Capsule>(&volume);
+            if (a && b && (a->rotation - b->rotation).cwiseAbs().maxCoeff() < 1e-9) seen = true;
+            if (c && d && c->p0 == d->p0 && c->p1 == d->p1) seen = true;
+        }
+        if (!seen && (std::holds_alternative<Obb>(volume) || std::holds_alternative<Capsule>(volume))) hints.push_back(volume);
+    }
+    return fit_fast(spheres, hints, policy);
+}
+
+TEST(Fast, QuickTreeletsOnlyLowerTheCostAndPriceNewNodesByFitFast) {
+    const VolumePolicy policy = VolumePolicy::all();
+    std::uint32_t rearranged = 0;
+    for (const std::uint64_t seed : {11u, 12u, 13u, 14u, 15u, 16u}) {
+        SCOPED_TRACE("seed " + std::to_string(seed));
+        const std::vector<Primitive> primitives = generated_scene(12 + 6 * static_cast<std::uint32_t>(seed - 10), seed);
+        const Bvh cheap = fast(primitives, policy, {.treelet_units = 0, .exact_fits = 0});
+        const Bvh swept = fast(primitives, policy, {.treelet_units = 5, .exact_fits = 0});
+        expect_tree_properties(primitives, swept);
+        const double before = cost(cheap, policy);
+        const double after = cost(swept, policy);
+        EXPECT_LE(after, before);
+        if (after < before) ++rearranged;
+        // Every inner node of the swept tree is a node of the cheap tree over the same primitives with its
+        // volume, or a new node whose volume is fit_fast's over its primitives (where the treelet's node
+        // kept the old one, that one is no larger).
+        std::vector<std::vector<std::uint32_t>> cheap_sets;
+        for (std::uint32_t i = 0; i < cheap.nodes.size(); ++i) {
+            std::vector<std::uint32_t> set = covered_primitives(cheap, i);
+            std::sort(set.begin(), set.end());
+            cheap_sets.push_back(std::move(set));
+        }
+        for (std::uint32_t i = 0; i < swept.nodes.size(); ++i) {
+            if (swept.nodes[i].is_leaf()) continue;
+            std::vector<std::uint32_t> set = covered_primitives(swept, i);
+            std::sort(set.begin(), set.end());
+            const auto old = std::find(cheap_sets.begin(), cheap_sets.end(), set);
+            const bool kept = old != cheap_sets.end() &&
+                              test_support::same_volume(swept.nodes[i].volume,
+                                                        cheap.nodes[static_cast<std::size_t>(old - cheap_sets.begin())].volume);
+            const bool fitted = test_support::same_volume(swept.nodes[i].volume, fit_fast_below(swept, i, policy));
+            EXPECT_TRUE(kept || fitted) << "node " << i;
+        }
+    }
+    EXPECT_GT(rearranged, 2u);  // the sweep did something on most of the six
+}
+
+TEST(Fast, NoQuickTreeletsAboveTheirCap) {
+    const std::vector<Primitive> primitives = generated_scene(40, 8);
+    const Bvh without = fast(primitives, VolumePolicy::all(), {.treelet_units = 0});
+    expect_identical_trees(without, fast(primitives, VolumePolicy::all(), {.treelet_max_primitives = 39}));
+    EXPECT_LT(cost(fast(primitives, VolumePolicy::all()), VolumePolicy::all()), cost(without, VolumePolicy::all()));
+}
+
 TEST(Fast, NodesOverTheCapAreNotRefitted) {
     const std::vector<Primitive> primitives = generated_scene(40, 9);
     const Bvh cheap = fast(primitives, VolumePolicy::all(), {.exact_fits = 0});
@@ -102,12 +171,14 @@ TEST(Fast, NodesOverTheCapAreNotRefitted) {
 }
 
 TEST(Fast, SameHierarchyForOneAndTwoThreads) {
-    const std::vector<Primitive> primitives = generated_scene(300, 21);
-    const auto build_with = [&](std::size_t threads) {
-        const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
-        return fast(primitives, VolumePolicy::all(), {.exact_fits = 8});
-    };
-    expect_identical_trees(build_with(1), build_with(2));
+    for (const std::uint32_t count : {60u, 300u}) {  // with the quick treelets, and above their cap
+        const std::vector<Primitive> primitives = generated_scene(count, 21);
+        const auto build_with = [&](std::size_t threads) {
+            const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+            return fast(primitives, VolumePolicy::all(), {.exact_fits = 8});
+        };
+        expect_identical_trees(build_with(1), build_with(2));
+    }
 }
 
 TEST(Fast, PropertiesOnEveryPolicy) {
