@@ -33,7 +33,7 @@ constexpr std::array registry{
     AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)", with_defaults<build_obbtree>},
     AlgorithmInfo{Algorithm::scale, "scale", "10^3-10^6 primitives: bottom-up levels, kNN candidates, exact partition per Morton window, multi-threaded (docs/scale.md)", with_defaults<build_scale>},
     AlgorithmInfo{Algorithm::binned, "binned", "10^4-10^6+ primitives: top-down binned volume splits, then the Eq. 2-optimal collapse into wide nodes (docs/scale.md 9)", with_defaults<build_binned>},
-    AlgorithmInfo{Algorithm::fast, "fast", "the speed preset (--quality fast): binned's tree with cheap fits, fit_best on the heaviest nodes; about a millisecond for a few dozen primitives", with_defaults<build_fast>},
+    AlgorithmInfo{Algorithm::fast, "fast", "the speed preset (--quality fast): binned's tree with cheap fits, treelets priced by cheap fits, fit_best on the heaviest nodes; about a millisecond for a few dozen primitives", with_defaults<build_fast>},
     AlgorithmInfo{Algorithm::automatic, "auto", "by size: optimal up to 10 primitives; above, the cheapest of a portfolio of builders, then treelet refinement (docs/treelets.md)", with_defaults<build_auto>},
 };
 }  // namespace

@@ -26,7 +26,7 @@ struct TreeletReport {
     std::uint32_t passes = 0;        ///< Sweeps run.
     std::uint32_t treelets = 0;      ///< Treelets solved.
     std::uint32_t replaced = 0;      ///< Treelets replaced by a strictly cheaper arrangement.
-    std::uint64_t fits = 0;          ///< fit_best calls (distinct covered sets; repeats are cached).
+    std::uint64_t fits = 0;          ///< Fits made (distinct covered sets; repeats are cached).
     double cost_before = 0.0;        ///< Eq. 2 with the policy's weights.
     double cost_after = 0.0;
     bool time_limit_hit = false;
