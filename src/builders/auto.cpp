@@ -1,91 +1,111 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/builders/auto.hpp"
 
+#include <mutex>
 #include <optional>
 #include <string>
+#include <vector>
+
+#include <tbb/parallel_for.h>
 
 #include "guarded_build.hpp"
 #include "report_text.hpp"
 #include "treelet_fit_cache.hpp"
 #include "hbvh/builders/build.hpp"
+#include "hbvh/assert.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
 namespace {
 
+/// One member's outcome: its (refined) tree, cost and report, or its error, or nothing when it was skipped.
+struct MemberOutcome {
+    std::optional<Result<Bvh>> tree;
+    double cost = 0.0;
+    std::string costs;  ///< "name cost" or "name cost -> refined cost", for the report
+    BuildReport report;
+    TreeletReport treelets;
+};
+
 /// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
 /// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
 /// comparison (refinement from different starts ends in different local optima, docs/treelets.md §3);
-/// above, up to auto_refine_max_primitives, only the winner is.
+/// above, up to auto_refine_max_primitives, only the winner is. The members run in parallel (each is a
+/// function of the primitives alone, and the winner is chosen in list order afterwards, so the result does
+/// not depend on the thread count or on which finishes first).
 Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext& context, const AutoOptions& options) {
     const std::vector<Algorithm> members = auto_portfolio(primitives.size());
     const bool refine_any = members.front() != Algorithm::optimal &&
                             (options.refine_always || primitives.size() <= auto_refine_max_primitives);
     const bool refine_each = refine_any && primitives.size() <= auto_refine_each_max_primitives;
-    std::optional<Bvh> best;
-    BuildReport best_report;
-    TreeletReport best_treelets;
-    Algorithm winner = members.front();
-    double best_cost = 0.0;
-    std::string costs;
     const bool limited = context.has_deadline();
-    std::string skipped;
-    std::size_t done = 0;
     // The members' trees are over the same primitives and refined under the same policy, and their
     // treelets cover many of the same sets: one cache fits each set once for all of them.
     detail::TreeletFitCache fits(primitives.size());
-    for (Algorithm member : members) {
+    std::vector<MemberOutcome> outcomes(members.size());
+    std::mutex progress_lock;
+    std::size_t done = 0;
+    tbb::parallel_for(std::size_t{0}, members.size(), [&](std::size_t m) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
-        if (best && limited && context.expired()) {
-            skipped += (skipped.empty() ? "" : ", ") + std::string(to_string(member));
+        if (m > 0 && limited && context.expired()) return;
+        MemberOutcome& outcome = outcomes[m];
+        BuildContext member_context = context;
+        member_context.report = context.report != nullptr ? &outcome.report : nullptr;
+        member_context.progress = nullptr;  // auto reports per member instead
+        Result<Bvh> built = build(primitives, members[m], member_context);
+        if (built) {
+            outcome.cost = cost(*built, context.policy);
+            outcome.costs = std::string(to_string(members[m])) + " " + detail::format_cost(outcome.cost);
+            if (refine_each) {
+                *built = detail::refine_treelets_cached(*built, context.policy,
+                                                        treelets_within(context, options.treelets), fits,
+                                                        &outcome.treelets);
+                outcome.cost = outcome.treelets.cost_after;
+                outcome.costs += " -> " + detail::format_cost(outcome.cost);
+            }
+        }
+        outcome.tree = std::move(built);
+        const std::lock_guard<std::mutex> lock(progress_lock);
+        context.report_progress(static_cast<double>(++done) / static_cast<double>(members.size() + 1));
+    });
+
+    // The first error in list order, else the cheapest tree, the first on ties.
+    std::size_t winner = members.size();
+    std::string costs;
+    std::string skipped;
+    for (std::size_t m = 0; m < members.size(); ++m) {
+        const MemberOutcome& outcome = outcomes[m];
+        if (!outcome.tree) {
+            skipped += (skipped.empty() ? "" : ", ") + std::string(to_string(members[m]));
             continue;
         }
-        BuildReport member_report;
-        BuildContext member_context = context;
-        member_context.report = context.report != nullptr ? &member_report : nullptr;
-        member_context.progress = nullptr;  // auto reports per member instead
-        Result<Bvh> built = build(primitives, member, member_context);
-        if (!built) return built;
-        Bvh tree = std::move(built.value());
-        double member_cost = cost(tree, context.policy);
-        if (!costs.empty()) costs += ", ";
-        costs += std::string(to_string(member)) + " " + detail::format_cost(member_cost);
-        TreeletReport treelets;
-        if (refine_each) {
-            tree = detail::refine_treelets_cached(tree, context.policy, treelets_within(context, options.treelets), fits,
-                                                  &treelets);
-            member_cost = treelets.cost_after;
-            costs += " -> " + detail::format_cost(member_cost);
-        }
-        if (!best || member_cost < best_cost) {
-            best = std::move(tree);
-            best_cost = member_cost;
-            best_report = std::move(member_report);
-            best_treelets = treelets;
-            winner = member;
-        }
-        context.report_progress(static_cast<double>(++done) / static_cast<double>(members.size() + 1));
+        if (!*outcome.tree) return std::move(*outcomes[m].tree);
+        costs += (costs.empty() ? "" : ", ") + outcome.costs;
+        if (winner == members.size() || outcome.cost < outcomes[winner].cost) winner = m;
     }
+    HBVH_ASSERT(winner < members.size());  // the first member always runs
+    Bvh best = std::move(**outcomes[winner].tree);
+    TreeletReport best_treelets = outcomes[winner].treelets;
     if (refine_any && !refine_each)
-        *best = detail::refine_treelets_cached(*best, context.policy, treelets_within(context, options.treelets), fits,
-                                               &best_treelets);
+        best = detail::refine_treelets_cached(best, context.policy, treelets_within(context, options.treelets), fits,
+                                              &best_treelets);
     if (context.report != nullptr) {
-        *context.report = std::move(best_report);
+        *context.report = std::move(outcomes[winner].report);
+        const std::string kept(to_string(members[winner]));
         if (members.size() > 1)
             context.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, portfolio " +
-                                            costs + (refine_each ? " (each refined)" : "") + "; kept " +
-                                            std::string(to_string(winner)));
+                                            costs + (refine_each ? " (each refined)" : "") + "; kept " + kept);
         else
             context.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
-                                            std::string(to_string(winner)));
+                                            kept);
         if (!skipped.empty()) {
             context.report->notes.push_back("auto: time limit reached; skipped " + skipped);
             context.report->budget_hit = true;
         }
         if (refine_any) note_treelets(*context.report, best_treelets);
     }
-    return Result<Bvh>(std::move(*best));
+    return Result<Bvh>(std::move(best));
 }
 }  // namespace
 
@@ -102,9 +122,9 @@ Algorithm auto_choice(std::size_t primitive_count) { return auto_portfolio(primi
 
 std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
     if (primitive_count <= auto_optimal_max_primitives) return {Algorithm::optimal};
-    if (primitive_count <= auto_exact_max_primitives)
-        return {Algorithm::bnb_exact, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split,
-                Algorithm::merge, Algorithm::scale, Algorithm::binned};
+    if (primitive_count <= auto_merge_max_primitives)
+        return {Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::merge, Algorithm::scale,
+                Algorithm::binned};
     if (primitive_count <= auto_insertion_max_primitives)
         return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::binned};
     if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::binned, Algorithm::split};

@@ -132,7 +132,7 @@ private:
     const VolumePolicy& policy_;
     std::uint32_t max_units_;
     std::vector<Item> items_;
-    std::unordered_map<std::vector<std::uint32_t>, Fitted, detail::CoveredSetHash>& cache_;
+    detail::TreeletFitCache::Map& cache_;
     detail::TreeletFitter fitter_;
     std::uint64_t fits_ = 0;
 };
@@ -208,9 +208,10 @@ bool Refiner::refine_at(std::uint32_t root) {
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), 4), fit_range);
     fits_ += missing.size();
     for (std::size_t j = 0; j < missing.size(); ++j) {
+        // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical
+        // (same set, same primitives, same policy), so either copy will do.
         auto [it, inserted] = cache_.emplace(std::move(missing[j].second), std::move(fresh[j]));
-        HBVH_ASSERT(inserted);
-        fitted[missing[j].first] = &it->second;  // unordered_map never moves its elements
+        fitted[missing[j].first] = &it->second;  // the map never moves its elements
     }
 
     // Stage 4: the subset volumes. Where the current tree already has a node over a set and its BV is

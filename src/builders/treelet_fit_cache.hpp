@@ -4,8 +4,9 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
+
+#include <tbb/concurrent_unordered_map.h>
 
 #include "hbvh/builders/treelet.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
@@ -32,7 +33,10 @@ struct CoveredSetHash {
 
 /// Fits by covered set (sorted input indices). A refinement's fit of a set depends on nothing but the set,
 /// the primitives and the policy, so sharing the cache between refinements of trees built over the same
-/// primitives (in input order, as every Bvh keeps them) under the same policy changes no result.
+/// primitives (in input order, as every Bvh keeps them) under the same policy changes no result, even when
+/// they run at the same time (auto refines its members in parallel): two threads that fit the same set
+/// compute the same volume, and whichever inserts it first, the other finds an identical one. The map
+/// inserts and finds concurrently and never moves an element, so pointers to fits stay valid.
 /// Which fitter a refinement prices its subsets with.
 enum class TreeletFitter {
     best,  ///< fit_best: the tightest volumes, about 0.05-0.2 ms per set of a few dozen primitives.
@@ -45,7 +49,8 @@ public:
         : primitive_count_(primitive_count), fitter_(fitter) {}
     [[nodiscard]] std::size_t primitive_count() const { return primitive_count_; }
     [[nodiscard]] TreeletFitter fitter() const { return fitter_; }
-    std::unordered_map<std::vector<std::uint32_t>, TreeletFit, CoveredSetHash> fits;
+    using Map = tbb::concurrent_unordered_map<std::vector<std::uint32_t>, TreeletFit, CoveredSetHash>;
+    Map fits;
 
 private:
     std::size_t primitive_count_;
@@ -54,7 +59,8 @@ private:
 
 /// refine_treelets with fits looked up in, and added to, `cache`. Precondition: every tree refined with
 /// one cache has the same primitives and is refined under the same policy. The report's `fits` counts the
-/// fits this call made, not those it found.
+/// fits this call made, not those it found (with refinements running at once, that count depends on timing;
+/// the tree does not).
 [[nodiscard]] Bvh refine_treelets_cached(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options,
                                          TreeletFitCache& cache, TreeletReport* report = nullptr);
 

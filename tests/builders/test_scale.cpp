@@ -5,12 +5,14 @@
 #include <tbb/global_control.h>
 
 #include <algorithm>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "support/test_helpers.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/builders/scale.hpp"
+#include "hbvh/builders/treelet.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -107,11 +109,11 @@ TEST(Scale, TimeLimitStillGivesAValidTree) {
 TEST(Auto, PicksBySizeAndSaysSo) {
     EXPECT_EQ(auto_choice(1), Algorithm::optimal);
     EXPECT_EQ(auto_choice(auto_optimal_max_primitives), Algorithm::optimal);
-    EXPECT_EQ(auto_choice(auto_optimal_max_primitives + 1), Algorithm::bnb_exact);
-    EXPECT_EQ(auto_choice(auto_exact_max_primitives), Algorithm::bnb_exact);
-    EXPECT_EQ(auto_choice(auto_exact_max_primitives + 1), Algorithm::scale);
+    EXPECT_EQ(auto_choice(auto_optimal_max_primitives + 1), Algorithm::insertion_haber);
+    EXPECT_EQ(auto_choice(auto_merge_max_primitives), Algorithm::insertion_haber);
+    EXPECT_EQ(auto_choice(auto_merge_max_primitives + 1), Algorithm::scale);
     ASSERT_EQ(parse_algorithm("auto"), Algorithm::automatic);
-    for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_exact_max_primitives + 10}) {
+    for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_merge_max_primitives + 10}) {
         const std::vector<Primitive> primitives = generated_scene(count, count);
         BuildReport report;
         BuildContext options;
@@ -125,6 +127,29 @@ TEST(Auto, PicksBySizeAndSaysSo) {
                    note.find(std::string(to_string(auto_choice(count)))) != std::string::npos;
         });
         EXPECT_NE(said, report.notes.end()) << (report.notes.empty() ? "" : report.notes.front());
+    }
+}
+
+// The members build and refine in parallel, sharing one fit cache; the winner is picked in list order
+// afterwards. With one thread or two, and against each member built and refined alone (its own cache,
+// one at a time), the same tree comes out.
+TEST(Auto, SameTreeForOneAndTwoThreadsAndAsTheMembersAlone) {
+    for (const std::uint32_t count : {auto_optimal_max_primitives + 4, auto_merge_max_primitives + 4}) {
+        SCOPED_TRACE(count);
+        const std::vector<Primitive> primitives = generated_scene(count, 40 + count);
+        const auto build_with = [&](std::size_t threads) {
+            const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+            return build(primitives, Algorithm::automatic, BuildContext{}).value();
+        };
+        const Bvh two = build_with(2);
+        test_support::expect_identical_trees(build_with(1), two);
+        // The cheapest member refined alone, the first on ties, as a serial loop would find it.
+        std::optional<Bvh> cheapest;
+        for (const Algorithm member : auto_portfolio(count)) {
+            const Bvh refined = refine_treelets(build(primitives, member, BuildContext{}).value(), VolumePolicy::all());
+            if (!cheapest || cost(refined) < cost(*cheapest)) cheapest = refined;
+        }
+        test_support::expect_identical_trees(*cheapest, two);
     }
 }
 

@@ -16,18 +16,18 @@
 namespace hbvh {
 
 /// Input sizes at which `auto` changes strategy (auto_portfolio). Up to auto_optimal_max_primitives: the
-/// optimal subset DP alone (~1 s at 10 primitives, doubling per primitive). Up to
-/// auto_exact_max_primitives: the cheapest of bnb-exact, insertion-haber, insertion, split, merge, scale and
-/// binned (bnb-exact's O(n^3) Tightest candidates take seconds at 20 and minutes at 50; the others milliseconds;
-/// none wins everywhere, docs/results.md §1). Up to auto_insertion_max_primitives: the cheapest of scale,
-/// insertion-haber, insertion, split and binned; up to auto_portfolio_max_primitives: of binned and split (at
-/// 1000 primitives the insertions took 5-7 s, split 0.2 s, binned 0.3 s, and either may be the cheaper).
-/// Above: binned alone, 0.2 s and 0.2 % cheaper than split at 20 000 primitives, where split takes 3 s
-/// (docs/scale.md §9).
+/// optimal subset DP alone (~0.2 s at 10-12 primitives, doubling per primitive). Up to
+/// auto_merge_max_primitives: the cheapest of insertion-haber, insertion, split, merge, scale and binned (none
+/// wins everywhere, docs/results.md §1; bnb-exact was a member too, at 60-80 % of auto's time there, and never
+/// strictly cheaper on the bundled and ../shared/data models: docs/treelets.md §4). Up to
+/// auto_insertion_max_primitives: the cheapest of scale, insertion-haber, insertion, split and binned; up to
+/// auto_portfolio_max_primitives: of binned and split (at 1000 primitives the insertions took 5-7 s, split
+/// 0.2 s, binned 0.3 s, and either may be the cheaper). Above: binned alone, 0.2 s and 0.2 % cheaper than split
+/// at 20 000 primitives, where split takes 3 s (docs/scale.md §9).
 /// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
 /// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
 inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
-inline constexpr std::uint32_t auto_exact_max_primitives = 24;
+inline constexpr std::uint32_t auto_merge_max_primitives = 24;
 inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
 inline constexpr std::uint32_t auto_portfolio_max_primitives = 2'000;
 inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
