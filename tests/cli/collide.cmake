@@ -103,8 +103,8 @@ endif()
 # identity every primitive overlaps its own copy; under any pose the number of overlapping pairs cannot depend
 # on whether the primitives come as a set or as a hierarchy (the hierarchy file may list them in another order,
 # so pairs are compared by count, and (i i) by index within one file). Every tree here is split's: which builder
-# made the trees cannot change the pairs, and auto's (at 13 primitives the cheapest of seven builders, bnb-exact
-# among them, each refined) took 2.5-3 s per tree under the sanitizers, 15 s of this test's 20.
+# made the trees cannot change the pairs, and auto's (at 13 primitives the cheapest of six builders, each refined;
+# with bnb-exact among them it took 2.5-3 s per tree under the sanitizers) would only lengthen it.
 run(0 ignored build ${chair} -a split -o ${WORK}/chair.hbvh.xml)
 collide_json(tree ${WORK}/chair.hbvh.xml ${WORK}/chair.hbvh.xml)
 expect_equal("chair hierarchy vs itself: intersecting" "${tree_intersecting}" ON)

@@ -45,10 +45,10 @@ struct AutoOptions {
 /// The first member of auto_portfolio(primitive_count).
 [[nodiscard]] Algorithm auto_choice(std::size_t primitive_count);
 
-/// Every member of auto_portfolio(n) builds a tree (through the registry, with its default options) and
-/// the cheapest under Eq. 2 wins (first on ties). Deadline: the members share it — each gets what is
-/// left, and those that would start after it are skipped (the first always runs) — and refinement gets
-/// what remains, stopping between treelets.
+/// Every member of auto_portfolio(n) builds a tree (through the registry, with its default options), in
+/// parallel, and the cheapest under Eq. 2 wins (first in the list on ties, whatever finished first).
+/// Deadline: the members share it — each gets what is left, and those that would start after it are
+/// skipped (the first always runs) — and refinement gets what remains, stopping between treelets.
 [[nodiscard]] Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildContext& context,
                                      const AutoOptions& options = {});
 
