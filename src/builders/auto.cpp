@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/builders/auto.hpp"
 
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
@@ -43,8 +42,6 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     // treelets cover many of the same sets: one cache fits each set once for all of them.
     detail::TreeletFitCache fits(primitives.size());
     std::vector<MemberOutcome> outcomes(members.size());
-    std::mutex progress_lock;
-    std::size_t done = 0;
     tbb::parallel_for(std::size_t{0}, members.size(), [&](std::size_t m) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
@@ -66,9 +63,9 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             }
         }
         outcome.tree = std::move(built);
-        const std::lock_guard<std::mutex> lock(progress_lock);
-        context.report_progress(static_cast<double>(++done) / static_cast<double>(members.size() + 1));
     });
+    // The callback is called from the calling thread only (BuildContext::progress), so once the members are done.
+    context.report_progress(static_cast<double>(members.size()) / static_cast<double>(members.size() + 1));
 
     // The first error in list order, else the cheapest tree, the first on ties.
     std::size_t winner = members.size();
