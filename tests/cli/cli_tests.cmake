@@ -150,3 +150,8 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
               -a split -o ${HBVH_CLI_OUT}/quality_excludes.xml)
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
+
+# --treelet-units reaches auto without --refine (its help says so; it once did only with --refine). On the cannon
+# three units keep insertion-haber's tree with one treelet replaced; the default seven end at scale's, 40.278.
+hbvh_cli_test(treelet_units.auto 0 "1 of 27 treelets replaced, [0-9]+ fits, cost 41.8691 -> 41.8559" build
+              ${PROJECT_SOURCE_DIR}/data/models/cannon.xml --treelet-units 3 --report -o ${HBVH_CLI_OUT}/cannon_units3.xml)

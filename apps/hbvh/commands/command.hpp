@@ -65,6 +65,11 @@ struct BuildRequest {
     [[nodiscard]] Result<Bvh> run(std::span<const Primitive> primitives) const;
 };
 
+/// `algorithm`'s tree, refined when `refine` (build_refined); `auto` refines with `treelets` either way, so that
+/// --treelet-units reaches it without --refine, as its help says.
+[[nodiscard]] Result<Bvh> build_requested(std::span<const Primitive> primitives, Algorithm algorithm,
+                                          const BuildContext& context, bool refine, const TreeletOptions& treelets);
+
 /// Options that select and steer a builder, shared by build, stats, compare, collide.
 struct BuilderFlags {
     std::string algorithm = "auto";

@@ -176,9 +176,15 @@ Result<BuildRequest> BuilderFlags::resolve() const {
     return request;
 }
 
+Result<Bvh> build_requested(std::span<const Primitive> primitives, Algorithm algorithm, const BuildContext& context,
+                            bool refine, const TreeletOptions& treelets) {
+    if (refine) return build_refined(primitives, algorithm, context, treelets);
+    if (algorithm == Algorithm::automatic) return build_auto(primitives, context, {false, treelets});
+    return build(primitives, algorithm, context);
+}
+
 Result<Bvh> BuildRequest::run(std::span<const Primitive> primitives) const {
-    const BuildContext timed = context.with_time_limit(time_limit_seconds);
-    return refine ? build_refined(primitives, algorithm, timed, treelets) : build(primitives, algorithm, timed);
+    return build_requested(primitives, algorithm, context.with_time_limit(time_limit_seconds), refine, treelets);
 }
 
 void BuilderFlags::add_refit_to(CLI::App& command) {

@@ -99,8 +99,7 @@ Result<Bvh> build_for_compare(const std::vector<Primitive>& primitives, Algorith
         }
         default: break;
     }
-    return settings.request.refine ? build_refined(primitives, algorithm, context, settings.request.treelets)
-                                   : build(primitives, algorithm, context);
+    return build_requested(primitives, algorithm, context, settings.request.refine, settings.request.treelets);
 }
 
 Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const CompareSettings& settings, int repeats) {
