@@ -43,7 +43,7 @@ using Fitted = detail::TreeletFit;
 
 /// True when two hints give fit_fast the same candidate: boxes whose rotations agree to 1e-9 (their frame is
 /// all fit_fast takes from them), or the same capsule segment (fit_fast uses its line).
-bool same_frame(const BoundingVolume& a, const BoundingVolume& b) {
+bool same_fit_fast_hint(const BoundingVolume& a, const BoundingVolume& b) {
     if (const Obb* box = std::get_if<Obb>(&a)) {
         const Obb* other = std::get_if<Obb>(&b);
         return other != nullptr && (box->rotation - other->rotation).cwiseAbs().maxCoeff() < 1e-9;
@@ -104,7 +104,7 @@ private:
                 append_generating_spheres(volume, spheres);
                 if (!std::holds_alternative<Obb>(volume) && !std::holds_alternative<Capsule>(volume)) continue;
                 const bool repeat = std::any_of(hints.begin(), hints.end(), [&](const BoundingVolume& hint) {
-                    return same_frame(hint, volume);
+                    return same_fit_fast_hint(hint, volume);
                 });
                 if (!repeat) hints.push_back(volume);
             }
@@ -177,10 +177,10 @@ bool Refiner::refine_at(std::uint32_t root) {
         current += static_cast<double>(items_[*it].children.size()) * policy_.weighted_volume(items_[*it].volume);
     }
 
-    // Stage 3: fit_best (or the quick fitter) over the primitives of every union of two or more units. Covered sets recur
-    // across treelets, passes and (through a shared cache) refinements of other trees over the same
-    // primitives, so fits are cached by set; the missing ones are fitted in parallel,
-    // each depending on its set only, so the result does not depend on the thread count.
+    // Stage 3: fit_best (or the quick fitter) over the primitives of every union of two or more units.
+    // Covered sets recur across treelets, passes and (through a shared cache) refinements of other trees over
+    // the same primitives, so fits are cached by set; the missing ones are fitted in parallel, each depending
+    // on its set only, so the result does not depend on the thread count.
     std::vector<std::vector<std::uint32_t>> unit_primitives(units);
     for (std::uint32_t i = 0; i < units; ++i) unit_primitives[i] = covered(frontier[i]);
     const std::uint32_t subsets = 1u << units;
@@ -210,7 +210,7 @@ bool Refiner::refine_at(std::uint32_t root) {
     for (std::size_t j = 0; j < missing.size(); ++j) {
         // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical
         // (same set, same primitives, same policy), so either copy will do.
-        auto [it, inserted] = cache_.emplace(std::move(missing[j].second), std::move(fresh[j]));
+        const auto it = cache_.emplace(std::move(missing[j].second), std::move(fresh[j])).first;
         fitted[missing[j].first] = &it->second;  // the map never moves its elements
     }
 
