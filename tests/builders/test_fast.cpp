@@ -171,7 +171,7 @@ TEST(Fast, NodesOverTheCapAreNotRefitted) {
 }
 
 TEST(Fast, SameHierarchyForOneAndTwoThreads) {
-    for (const std::uint32_t count : {60u, 300u}) {  // with the quick treelets, and above their cap
+    for (const std::uint32_t count : {40u, 300u}) {  // with the quick treelets (up to 48), and above their cap
         const std::vector<Primitive> primitives = generated_scene(count, 21);
         const auto build_with = [&](std::size_t threads) {
             const tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
