@@ -41,18 +41,6 @@ struct Item {
 
 using Fitted = detail::TreeletFit;
 
-/// True when two hints give fit_fast the same candidate: boxes whose rotations agree to 1e-9 (their frame is
-/// all fit_fast takes from them), or the same capsule segment (fit_fast uses its line).
-bool same_fit_fast_hint(const BoundingVolume& a, const BoundingVolume& b) {
-    if (const Obb* box = std::get_if<Obb>(&a)) {
-        const Obb* other = std::get_if<Obb>(&b);
-        return other != nullptr && (box->rotation - other->rotation).cwiseAbs().maxCoeff() < 1e-9;
-    }
-    const Capsule* capsule = std::get_if<Capsule>(&a);
-    const Capsule* other = std::get_if<Capsule>(&b);
-    return capsule != nullptr && other != nullptr && capsule->p0 == other->p0 && capsule->p1 == other->p1;
-}
-
 class Refiner {
 public:
     Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
@@ -95,24 +83,23 @@ public:
 private:
     /// The volume over the primitives of one covered set, by the cache's fitter.
     [[nodiscard]] BoundingVolume fit_set(std::span<const std::uint32_t> set) const {
-        if (fitter_ == detail::TreeletFitter::quick) {
-            std::vector<Sphere> spheres;
-            std::vector<BoundingVolume> hints;
-            hints.reserve(set.size());
-            for (std::uint32_t p : set) {
-                const BoundingVolume& volume = primitives_[p].volume;
-                append_generating_spheres(volume, spheres);
-                if (!std::holds_alternative<Obb>(volume) && !std::holds_alternative<Capsule>(volume)) continue;
-                const bool repeat = std::any_of(hints.begin(), hints.end(), [&](const BoundingVolume& hint) {
-                    return same_fit_fast_hint(hint, volume);
-                });
-                if (!repeat) hints.push_back(volume);
-            }
-            return fit_fast(spheres, hints, policy_);
-        }
         FitInput input;
         for (std::uint32_t p : set) input.add(primitives_[p].volume);
-        return fit_best(input.spheres, policy_, input.hint_axes);
+        if (fitter_ == detail::TreeletFitter::best) return fit_best(input.spheres, policy_, input.hint_axes);
+        // fit_fast takes only a box hint's frame, so FitInput's distinct box frames stand in for the boxes; it
+        // places a capsule along each capsule hint's line, so the distinct capsules go as they are.
+        std::vector<BoundingVolume> hints;
+        for (const Mat3& axes : input.hint_axes) hints.emplace_back(Obb{Vec3::Zero(), axes, Vec3::Zero()});
+        for (std::uint32_t p : set) {
+            const Capsule* capsule = std::get_if<Capsule>(&primitives_[p].volume);
+            if (capsule == nullptr) continue;
+            const bool repeat = std::any_of(hints.begin(), hints.end(), [&](const BoundingVolume& hint) {
+                const Capsule* seen = std::get_if<Capsule>(&hint);
+                return seen != nullptr && seen->p0 == capsule->p0 && seen->p1 == capsule->p1;
+            });
+            if (!repeat) hints.emplace_back(*capsule);
+        }
+        return fit_fast(input.spheres, hints, policy_);
     }
 
     [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {

@@ -31,18 +31,18 @@ struct CoveredSetHash {
     }
 };
 
+/// Which fitter a refinement prices its subsets with.
+enum class TreeletFitter {
+    best,  ///< fit_best: the tightest volumes, about 0.05-0.2 ms per set of a few dozen primitives.
+    quick  ///< fit_fast, the set's distinct box frames and capsules as hints: microseconds, a little larger.
+};
+
 /// Fits by covered set (sorted input indices). A refinement's fit of a set depends on nothing but the set,
 /// the primitives and the policy, so sharing the cache between refinements of trees built over the same
 /// primitives (in input order, as every Bvh keeps them) under the same policy changes no result, even when
 /// they run at the same time (auto refines its members in parallel): two threads that fit the same set
 /// compute the same volume, and whichever inserts it first, the other finds an identical one. The map
 /// inserts and finds concurrently and never moves an element, so pointers to fits stay valid.
-/// Which fitter a refinement prices its subsets with.
-enum class TreeletFitter {
-    best,  ///< fit_best: the tightest volumes, about 0.05-0.2 ms per set of a few dozen primitives.
-    quick  ///< fit_fast over the set's spheres with its primitives as hints: microseconds, a little larger.
-};
-
 class TreeletFitCache {
 public:
     explicit TreeletFitCache(std::size_t primitive_count, TreeletFitter fitter = TreeletFitter::best)
