@@ -65,8 +65,10 @@ private:
         const Vec3 ac = points_[c] - points_[a];
         const Vec3 n = ab.cross(ac);
         const double length = n.norm();
-        // |ab x ac| = |ab| |ac| sin(angle): below ~1e-9 the direction of n is mostly rounding.
-        if (!(length > 1e-9 * ab.norm() * ac.norm())) return std::nullopt;
+        // |ab x ac| = |ab| |ac| sin(angle), and n's direction is off by about eps / sin(angle): a point at the
+        // set's scale is then misplaced by up to 2 eps scale / sin. Above 1e-5 that stays under 5e-11 of the
+        // scale; thinner triangles (a cluster of nanometres beside a far point, found by fuzz_collide) go to qhull.
+        if (!(length > 1e-5 * ab.norm() * ac.norm())) return std::nullopt;
         Face face;
         face.vertex = {a, b, c};
         face.normal = n / length;
@@ -111,20 +113,27 @@ private:
             if (const double s = (d - d.dot(u) * u).norm(); s > off_line) off_line = s, i2 = i;
         }
         if (!(off_line > tolerance_)) return false;
-        const Vec3 n = (points_[i1] - points_[i0]).cross(points_[i2] - points_[i0]).normalized();
+        const Vec3 u1 = points_[i1] - points_[i0];
+        const Vec3 u2 = points_[i2] - points_[i0];
+        const Vec3 n = u1.cross(u2).normalized();
         std::uint32_t i3 = i0;
         double off_plane = 0.0;
         for (std::uint32_t i = 0; i < points_.size(); ++i)
             if (const double s = std::abs(n.dot(points_[i] - points_[i0])); s > off_plane) off_plane = s, i3 = i;
         if (!(off_plane > tolerance_)) return false;
 
-        // Each face turned so that the fourth vertex lies below it.
-        const std::array<std::array<std::uint32_t, 4>, 4> corners{
-            {{i0, i1, i2, i3}, {i0, i1, i3, i2}, {i0, i2, i3, i1}, {i1, i2, i3, i0}}};
-        for (const auto& [a, b, c, opposite] : corners) {
-            const bool below = (points_[b] - points_[a]).cross(points_[c] - points_[a]).dot(points_[opposite] - points_[a]) < 0.0;
-            if (!(below ? add_face(a, b, c) : add_face(a, c, b))) return false;
-        }
+        // One orientation for the whole tetrahedron, from one determinant whose sign must be beyond rounding
+        // (its error is a few eps |u1| |u2| |u3|); the faces then take their vertex order from it, so every
+        // edge is shared by two faces running it in opposite directions. (Deciding each face on its own from a
+        // determinant near rounding once turned two faces the same way: an unlinked edge, a crash.)
+        const Vec3 u3 = points_[i3] - points_[i0];
+        const double orientation = u1.cross(u2).dot(u3);
+        if (!(std::abs(orientation) > 1e-9 * u1.norm() * u2.norm() * u3.norm())) return false;
+        if (orientation < 0.0) std::swap(i1, i2);
+        // With i3 above the plane (i0, i1, i2), these four run counter-clockwise seen from outside.
+        const std::array<std::array<std::uint32_t, 3>, 4> simplex{{{i0, i2, i1}, {i0, i1, i3}, {i1, i2, i3}, {i0, i3, i2}}};
+        for (const auto& [a, b, c] : simplex)
+            if (!add_face(a, b, c)) return false;
         // Neighbours: the face holding the same edge the other way round.
         for (std::uint32_t f = 0; f < 4; ++f)
             for (int k = 0; k < 3; ++k) {
@@ -133,6 +142,7 @@ private:
                 faces_[f].neighbor[static_cast<std::size_t>(k)] = none;
                 for (std::uint32_t g = 0; g < 4; ++g)
                     if (g != f && edge_index(g, b, a) >= 0) faces_[f].neighbor[static_cast<std::size_t>(k)] = g;
+                if (faces_[f].neighbor[static_cast<std::size_t>(k)] == none) return false;
             }
         const std::array<std::uint32_t, 4> simplex_faces{0, 1, 2, 3};
         for (std::uint32_t i = 0; i < points_.size(); ++i)
@@ -158,6 +168,10 @@ private:
         for (int step = 0; step < 3; ++step) {
             const int k = (entry + step) % 3;
             const std::uint32_t other = faces_[face].neighbor[static_cast<std::size_t>(k)];
+            if (other == none || !faces_[other].alive) {
+                linked_ = false;
+                continue;
+            }
             if (faces_[other].visible) continue;
             if (distance(other, eye) > tolerance_) {
                 const std::uint32_t a = faces_[face].vertex[static_cast<std::size_t>(k)];
