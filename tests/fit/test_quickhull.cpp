@@ -235,6 +235,32 @@ TEST(Quickhull, TinyClustersBesideFarPoints) {
     RecordProperty("solved", solved);
 }
 
+/// Nearly flat and nearly straight sets at random (thickness 1e-14 to 1e-4 of their extent, turned at random),
+/// with repeated points: rounding decides most of their faces. Each answer is a hull or nothing.
+TEST(Quickhull, NearlyFlatAndNearlyStraightSets) {
+    SplitMix64 rng(31);
+    int solved = 0;
+    for (int trial = 0; trial < 2000; ++trial) {
+        const Mat3 turn = rng.rotation();
+        const double thin = std::pow(10.0, rng.uniform(-14.0, -4.0));
+        const bool straight = trial % 2 == 1;
+        const int count = 4 + static_cast<int>(rng.uniform(0.0, 40.0));
+        std::vector<Vec3> points;
+        for (int i = 0; i < count; ++i) {
+            const Vec3 local(rng.uniform(-1, 1), straight ? thin * rng.uniform(-1, 1) : rng.uniform(-1, 1),
+                             thin * rng.uniform(-1, 1));
+            points.push_back(turn * local);
+            if (i % 7 == 3) points.push_back(points.back());  // a repeated point
+        }
+        const std::vector<Vec3> shifted = centred(points);
+        if (const std::optional<TriangleHull> hull = detail::quickhull(shifted)) {
+            ++solved;
+            expect_hull_of(shifted, *hull, 1e-10 * scale_of(shifted), "trial " + std::to_string(trial));
+        }
+    }
+    RecordProperty("solved", solved);
+}
+
 TEST(Quickhull, RepeatedAndInteriorPointsAreNoVertices) {
     // A cube's corners, each three times, plus points inside and on its faces: eight vertices.
     std::vector<Vec3> points;
