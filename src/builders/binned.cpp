@@ -18,6 +18,7 @@
 
 #include "guarded_build.hpp"
 #include "heuristic_support.hpp"
+#include "../memory/huge_pages.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "../fit/frames.hpp"
@@ -26,6 +27,7 @@ namespace hbvh {
 namespace binned_internal {  // named, so that a unity build's other anonymous helpers cannot collide
 namespace {
 
+using detail::LargeVector;
 using detail::PrimitiveSet;
 
 constexpr std::uint32_t max_children_limit = 16;
@@ -145,15 +147,16 @@ public:
     Bvh build(std::span<const Primitive> primitives) {
         const std::uint32_t root = plan(0, static_cast<std::uint32_t>(refs_.size()), 0);
         Bvh bvh;
+        detail::reserve_on_huge_pages(bvh.primitives, primitives.size());
         bvh.primitives.assign(primitives.begin(), primitives.end());
         if (nodes_[root].is_leaf) {
             bvh.nodes.push_back(Node{primitives[set_.input_index(refs_[0].local)].volume, 0, 0, set_.input_index(refs_[0].local)});
             return bvh;
         }
-        std::vector<WideNode> wide;
+        LargeVector<WideNode> wide;
         collect(root, split_of(root)[1], wide);
-        std::vector<double>().swap(best_);  // the collapse is decided: its tables are a fifth of the memory
-        std::vector<std::uint8_t>().swap(split_);
+        LargeVector<double>().swap(best_);  // the collapse is decided: its tables are a fifth of the memory
+        LargeVector<std::uint8_t>().swap(split_);
         fit_all(wide);
         lay_out(wide, bvh);
         return bvh;
@@ -376,7 +379,7 @@ private:
     }
 
     /// Appends the slots of the `k` pieces of binary node `slot` (kept nodes or leaves), left to right.
-    void pieces(std::uint32_t slot, std::uint32_t k, std::vector<std::uint32_t>& out) {
+    void pieces(std::uint32_t slot, std::uint32_t k, LargeVector<std::uint32_t>& out) {
         if (k == 1) {
             out.push_back(slot);
             return;
@@ -388,7 +391,7 @@ private:
 
     /// The kept nodes below and at `slot` (kept with `k` children), children before parents. Their moments
     /// are summed later, in parallel, by fit_subtree (this walk is serial, and summing here was most of it).
-    void collect(std::uint32_t slot, std::uint32_t k, std::vector<WideNode>& wide) {
+    void collect(std::uint32_t slot, std::uint32_t k, LargeVector<WideNode>& wide) {
         WideNode node;
         node.slot = slot;
         node.first_piece = static_cast<std::uint32_t>(pieces_.size());
@@ -405,7 +408,7 @@ private:
     /// The moments of kept node `node` from its pieces, left to right: a leaf's spheres, a kept child's sum
     /// (already made: children are fitted first). The same additions in the same order whichever thread
     /// runs them, so the sums do not depend on the thread count.
-    [[nodiscard]] Moments moments_of(const WideNode& node, const std::vector<std::uint32_t>& wide_of_slot) const {
+    [[nodiscard]] Moments moments_of(const WideNode& node, const LargeVector<std::uint32_t>& wide_of_slot) const {
         Moments sum;
         for (std::uint32_t p = node.first_piece; p < node.first_piece + node.piece_count; ++p) {
             const std::uint32_t child = pieces_[p];
@@ -421,15 +424,15 @@ private:
 
     /// Fits every kept node, children before parents (a node's hull fit uses its children's volumes), the
     /// subtrees of large nodes in parallel. Each volume depends on its subtree only, so on no thread count.
-    void fit_all(std::vector<WideNode>& wide) {
-        std::vector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
+    void fit_all(LargeVector<WideNode>& wide) {
+        LargeVector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
         for (std::uint32_t i = 0; i < wide.size(); ++i) wide_of_slot[wide[i].slot] = i;
         if (needs_moments_) moments_.resize(wide.size());
         std::atomic<std::uint64_t> fitted{0};
         fit_subtree(static_cast<std::uint32_t>(wide.size() - 1), wide, wide_of_slot, fitted);
     }
 
-    void fit_subtree(std::uint32_t index, std::vector<WideNode>& wide, const std::vector<std::uint32_t>& wide_of_slot,
+    void fit_subtree(std::uint32_t index, LargeVector<WideNode>& wide, const LargeVector<std::uint32_t>& wide_of_slot,
                      std::atomic<std::uint64_t>& fitted) {
         WideNode& node = wide[index];
         const BinaryNode& binary = nodes_[node.slot];
@@ -456,8 +459,8 @@ private:
     /// - for nodes over at least `hull_fit_min_primitives`, fit_obb (hull-based) around its children's
     ///   volumes: it encloses them, so the primitives, and has a few dozen points however large the node is;
     /// - fit_best over the primitives, for nodes of at most `exact_fit_max_primitives`.
-    BoundingVolume fit_node(const WideNode& wide_node, const std::vector<WideNode>& wide,
-                            const std::vector<std::uint32_t>& wide_of_slot, const Moments& moments) const {
+    BoundingVolume fit_node(const WideNode& wide_node, const LargeVector<WideNode>& wide,
+                            const LargeVector<std::uint32_t>& wide_of_slot, const Moments& moments) const {
         const BinaryNode& node = nodes_[wide_node.slot];
         const VolumePolicy& policy = set_.policy();
         double best_volume = infinity;
@@ -554,10 +557,10 @@ private:
 
     /// `wide` (children before parents, the root last) as `bvh.nodes`, breadth-first (a node's children are
     /// appended together, so they are contiguous). Leaves carry their primitive's own volume.
-    void lay_out(std::vector<WideNode>& wide, Bvh& bvh) const {
-        std::vector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
+    void lay_out(LargeVector<WideNode>& wide, Bvh& bvh) const {
+        LargeVector<std::uint32_t> wide_of_slot(nodes_.size(), 0);
         for (std::uint32_t i = 0; i < wide.size(); ++i) wide_of_slot[wide[i].slot] = i;
-        bvh.nodes.reserve(wide.size() + refs_.size());
+        detail::reserve_on_huge_pages(bvh.nodes, wide.size() + refs_.size());
         std::vector<std::uint32_t> queue{static_cast<std::uint32_t>(wide.size() - 1)}, node_of(1, 0);
         bvh.nodes.push_back(Node{std::move(wide.back().volume), 0, 0, 0});
         for (std::size_t q = 0; q < queue.size(); ++q) {
@@ -589,13 +592,13 @@ private:
     double box_weight_ = 1.0;
     NodeMeasure measure_ = NodeMeasure::volume;
     bool needs_moments_ = false;               ///< Whether OBBs or capsules are fitted (they need a frame).
-    std::vector<std::uint32_t> pieces_;        ///< The kept nodes' children, as slots, node after node.
-    std::vector<Moments> moments_;             ///< Per kept node (as `wide`), when needs_moments_.
+    LargeVector<std::uint32_t> pieces_;        ///< The kept nodes' children, as slots, node after node.
+    LargeVector<Moments> moments_;             ///< Per kept node (as `wide`), when needs_moments_.
     std::atomic<std::uint64_t> placed_{0};  ///< Leaves made so far, for progress (any thread).
-    std::vector<Ref> refs_;                 ///< The primitives; each plan() reorders only its range.
-    std::vector<BinaryNode> nodes_;         ///< n leaves, then n - 1 inner nodes by their cut position.
-    std::vector<double> best_;              ///< (max_children + 1) collapse costs per node.
-    std::vector<std::uint8_t> split_;       ///< (max_children + 1) collapse choices per node.
+    LargeVector<Ref> refs_;                 ///< The primitives; each plan() reorders only its range.
+    LargeVector<BinaryNode> nodes_;         ///< n leaves, then n - 1 inner nodes by their cut position.
+    LargeVector<double> best_;              ///< (max_children + 1) collapse costs per node.
+    LargeVector<std::uint8_t> split_;       ///< (max_children + 1) collapse choices per node.
 };
 
 }  // namespace

@@ -12,6 +12,7 @@
 
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "../memory/huge_pages.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -81,7 +82,14 @@ PrimitiveSet::PrimitiveSet(std::span<const Primitive> primitives, std::vector<st
                            const VolumePolicy& policy)
     : primitives_(primitives), order_(std::move(order)), policy_(policy) {
     HBVH_ASSERT(order_.size() == primitives.size());
-    sphere_begin_.reserve(order_.size() + 1);
+    // Every array at its final size before the first write: no regrowth, and large inputs on huge pages.
+    std::size_t sphere_count = 0;
+    for (const Primitive& p : primitives)
+        sphere_count += std::holds_alternative<Sphere>(p.volume) ? 1 : std::holds_alternative<Capsule>(p.volume) ? 2 : 8;
+    reserve_on_huge_pages(spheres_, sphere_count);
+    reserve_on_huge_pages(sphere_begin_, order_.size() + 1);
+    reserve_on_huge_pages(centres_, order_.size());
+    reserve_on_huge_pages(volumes_, order_.size());
     sphere_begin_.push_back(0);
     for (const std::uint32_t input : order_) {
         const BoundingVolume& bv = primitives_[input].volume;

@@ -12,6 +12,8 @@
 #include <chrono>
 #include <system_error>
 
+#include "../memory/huge_pages.hpp"
+
 namespace hbvh {
 namespace {
 
@@ -89,7 +91,12 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
     // A regular file is read straight into a string of its size: growing a string chunk by chunk would copy
     // a large file several times over.
     std::string content;
-    if (S_ISREG(info.st_mode) && info.st_size > 0) content.resize(static_cast<std::size_t>(info.st_size));
+    if (S_ISREG(info.st_mode) && info.st_size > 0) {
+        const auto size = static_cast<std::size_t>(info.st_size);
+        content.reserve(size);
+        detail::advise_huge_pages(content.data(), size);  // before the first write: see memory/huge_pages.hpp
+        content.resize(size);
+    }
     std::size_t filled = 0;
     while (filled < content.size()) {
         const ssize_t count = read_some(file.get(), content.data() + filled, content.size() - filled);

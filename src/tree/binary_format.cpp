@@ -28,6 +28,7 @@
 
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "../memory/huge_pages.hpp"
 
 namespace hbvh {
 namespace {
@@ -402,22 +403,6 @@ bool is_plain_ascii(std::string_view text) {
     return true;
 }
 
-/// Asks the kernel to back [data, data + bytes) with huge pages when it is filled, where it can (Linux, when
-/// transparent huge pages are set to "madvise" or "always"). A 10^6-primitive Bvh is about 300 MB that the
-/// loader writes once, front to back; in 4 KiB pages that is 75 000 page faults, which cost more than all the
-/// decoding (about 140 ms against 20 ms in 2 MiB pages on the machine of docs/formats.md). Only the 2 MiB-aligned
-/// interior of a large buffer is advised; the advice is a hint, and failing to take it changes nothing else.
-void advise_huge_pages([[maybe_unused]] void* data, [[maybe_unused]] std::size_t bytes) {
-#ifdef MADV_HUGEPAGE
-    constexpr std::uintptr_t huge_page = std::uintptr_t{1} << 21;
-    if (bytes < 2 * huge_page) return;  // then the interior holds at least one huge page
-    const auto first = reinterpret_cast<std::uintptr_t>(data);
-    const std::uintptr_t begin = (first + huge_page - 1) & ~(huge_page - 1);
-    const std::uintptr_t end = (first + bytes) & ~(huge_page - 1);
-    if (end > begin) ::madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#endif
-}
-
 /// What one decoding task found: a problem and its offset (empty when its records parsed), and whether every
 /// record also passed the on-the-fly checks of read_binary's stage 3.
 struct DecodeOutcome {
@@ -536,7 +521,10 @@ std::string write_binary(const Bvh& bvh) {
     std::size_t size = binary_header_size + binary_checksum_size;
     for (const Node& node : bvh.nodes) size += volume_record_size(node.volume) + binary_node_links_size;
     for (const Primitive& primitive : bvh.primitives) size += volume_record_size(primitive.volume) + 4 + primitive.name.size();
-    std::string out(size, '\0');
+    std::string out;
+    out.reserve(size);
+    detail::advise_huge_pages(out.data(), size);  // before the first write: see memory/huge_pages.hpp
+    out.resize(size);
     auto* data = reinterpret_cast<unsigned char*>(out.data());
     BinaryWriter writer(data);
 
@@ -654,12 +642,12 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
         if (concurrent && !(corrupted = checksum_problem()).empty()) return;
         // reserve and append rather than resize: the (large) arrays are then written once, not zeroed first.
         bvh.nodes.reserve(node_count);
-        advise_huge_pages(bvh.nodes.data(), node_count * sizeof(Node));
+        detail::advise_huge_pages(bvh.nodes.data(), node_count * sizeof(Node));
         nodes_outcome = decode_node_records(data, checksum_at, node_count, primitive_count, bvh.nodes);
     };
     auto decode_primitives = [&] {
         bvh.primitives.reserve(primitive_count);
-        advise_huge_pages(bvh.primitives.data(), primitive_count * sizeof(Primitive));
+        detail::advise_huge_pages(bvh.primitives.data(), primitive_count * sizeof(Primitive));
         primitives_outcome = decode_primitive_records(data, checksum_at, node_count, primitive_count, bvh.primitives);
     };
     if (concurrent) tbb::parallel_invoke(decode_nodes, decode_primitives);
@@ -734,7 +722,7 @@ Result<Bvh> read_binary_file(const std::filesystem::path& path) {
     if (failure == 0 && !S_ISDIR(info.st_mode)) {
         capacity = S_ISREG(info.st_mode) && info.st_size > 0 ? static_cast<std::size_t>(info.st_size) : 65536;
         bytes.reset(new std::byte[capacity]);
-        advise_huge_pages(bytes.get(), capacity);
+        detail::advise_huge_pages(bytes.get(), capacity);
         for (;;) {
             if (filled == capacity) {
                 // Full: look for more in a small buffer before doubling, so that a file of exactly st_size bytes

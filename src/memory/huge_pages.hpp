@@ -1,0 +1,57 @@
+// SPDX-License-Identifier: MIT
+// Large buffers on 2 MiB pages. A build of 10^6 primitives first-touches about a gigabyte; in 4 KiB pages that
+// is some 300 000 page faults, and on the virtual machines of docs/scale.md §9 ("Page faults") they took 3.4 of
+// `binned`'s 7.8 s; the binary loader saw the same (docs/formats.md). Linux backs memory with transparent huge
+// pages where a program asks for them (madvise) even when they are not on for everything, so the library asks,
+// for its own large buffers.
+#pragma once
+
+#include <cstddef>
+#include <new>
+#include <vector>
+
+namespace hbvh::detail {
+
+/// Buffers from this size on are advised: their 2 MiB-aligned interior then holds at least one huge page.
+inline constexpr std::size_t huge_page_advice_min_bytes = std::size_t{4} << 20;
+
+/// Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes) with huge pages: Linux's
+/// madvise(MADV_HUGEPAGE), nothing elsewhere or below huge_page_advice_min_bytes. Advice only: it changes no
+/// value, and a refusal (no THP in the kernel, a region not from mmap) is ignored. Call it before the memory
+/// is first written, since a page already touched stays small.
+void advise_huge_pages(void* data, std::size_t bytes) noexcept;
+
+/// std::allocator, except that every large allocation is advised (advise_huge_pages). For the builders'
+/// own large arrays; the public types keep std::allocator and are advised after reserve().
+template <class T>
+struct HugePageAllocator {
+    using value_type = T;
+    HugePageAllocator() = default;
+    template <class U>
+    explicit HugePageAllocator(const HugePageAllocator<U>& /*other*/) noexcept {}
+
+    [[nodiscard]] T* allocate(std::size_t count) {
+        T* data = std::allocator<T>().allocate(count);
+        advise_huge_pages(data, count * sizeof(T));
+        return data;
+    }
+    void deallocate(T* data, std::size_t count) noexcept { std::allocator<T>().deallocate(data, count); }
+
+    template <class U>
+    bool operator==(const HugePageAllocator<U>& /*other*/) const noexcept {
+        return true;
+    }
+};
+
+/// A vector for a builder's arrays over every primitive or node.
+template <class T>
+using LargeVector = std::vector<T, HugePageAllocator<T>>;
+
+/// reserve(count), then the advice, so that the elements written after it land on huge pages.
+template <class T, class Allocator>
+void reserve_on_huge_pages(std::vector<T, Allocator>& vector, std::size_t count) {
+    vector.reserve(count);
+    advise_huge_pages(vector.data(), vector.capacity() * sizeof(T));
+}
+
+}  // namespace hbvh::detail
