@@ -5,7 +5,7 @@
 # clone). Only the order depends on these numbers; a name that no longer exists is ignored. Refresh them from a
 # run's output (the "Passed ... sec" column) when tests are added or their times change a lot.
 set_tests_properties("EveryAlgorithm/TandemTraversalPerBuilder.MatchesBruteForce/auto" PROPERTIES COST 47)
-set_tests_properties("SurveyHeuristics/EveryHeuristic.PropertiesOnGeneratedScenesOfEverySize/insertion_haber" PROPERTIES COST 31)
+set_tests_properties("SurveyHeuristics/EveryHeuristic.PropertiesOnGeneratedScenesOfEverySize/insertion_haber" PROPERTIES COST 15)
 set_tests_properties("BnbExact.EachLevelOptimalAndNoCostlierThanEnlargesOnBundledModels" PROPERTIES COST 28)
 set_tests_properties("Precision.RestingContactsFarFromTheOriginAreFound" PROPERTIES COST 26)
 set_tests_properties("EveryAlgorithm/TandemTraversalPerBuilder.MatchesBruteForce/bnb_exact" PROPERTIES COST 25)
