@@ -53,8 +53,8 @@ double cost_of(const std::vector<Primitive>& primitives, Algorithm algorithm) {
 class EveryHeuristic : public testing::TestWithParam<Algorithm> {};
 
 // Every size up to 32 (the small objects, where the degenerate groupings are), then a sample up to 60, both
-// sides of 48. Every size up to 60 took 37 s for insertion-haber under the sanitizers (a twelfth of the suite's
-// time on two cores) for sizes that exercise no path the sample does not.
+// sides of 48. Every size up to 60 took 37 s for insertion-haber under the sanitizers, a twelfth of the suite's
+// time on two cores.
 TEST_P(EveryHeuristic, PropertiesOnGeneratedScenesOfEverySize) {
     std::vector<std::uint32_t> counts;
     for (std::uint32_t count = 1; count <= 32; ++count) counts.push_back(count);
