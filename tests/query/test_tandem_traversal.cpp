@@ -138,7 +138,8 @@ struct Case {
 };
 
 /// One builder's trees over the shared cases: all, first and two-level against brute force.
-/// Work over all queries of check_builder: primitive tests run vs primitive pairs that exist.
+/// Work over all queries of check_builder: primitive tests run by pure descent (flat limit 0: the default
+/// tests small and concentric pairs flat on purpose) vs primitive pairs that exist.
 struct Work {
     std::uint64_t primitive_tests = 0, primitive_pairs = 0;
 };
@@ -171,6 +172,7 @@ Work check_builder(const std::string& name, const std::function<Bvh(std::span<co
                 for (const std::uint64_t flat_limit : {std::uint64_t{0}, std::numeric_limits<std::uint64_t>::max()}) {
                     collide(qa, pose_a, qb, pose_b, CollideMode::all, reused, flat_limit);
                     EXPECT_EQ(reused.pairs, expected) << where << " flat limit " << flat_limit;
+                    if (flat_limit == 0) work.primitive_tests += reused.primitive_tests;  // the hierarchy's own pruning
                 }
                 collide(qa, pose_a, qb, pose_b, CollideMode::all, reused);
                 EXPECT_EQ(reused.pairs, expected) << where;
@@ -189,7 +191,6 @@ Work check_builder(const std::string& name, const std::function<Bvh(std::span<co
                 const CollideResult baseline_first = collide_two_level(qa, pose_a, qb, pose_b, CollideMode::first);
                 EXPECT_EQ(baseline_first.intersecting, !expected.empty()) << where;
 
-                work.primitive_tests += reused.primitive_tests;
                 work.primitive_pairs += std::uint64_t{c.count_a} * c.count_b;
                 ++queries;
                 intersecting += expected.empty() ? 0 : 1;
@@ -228,6 +229,39 @@ INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, TandemTraversalPerBuilder,
                              std::replace(name.begin(), name.end(), '-', '_');
                              return name;
                          });
+
+/// Copies on top of each other: the roots nearly share a centre, so every leaf pair is tested directly (one BV
+/// test, the roots'), with the brute-force answer; moved aside by more than half the smaller root sphere's
+/// radius, or with the flat limit at 0, the same pair of trees is descended again.
+TEST(TandemTraversal, ConcentricRootsAreTestedLeafByLeaf) {
+    const std::vector<Primitive> primitives = generate_scene({.count = 13, .seed = 21});
+    const Result<Bvh> built = build(primitives, Algorithm::split);
+    ASSERT_TRUE(built.has_value());
+    const QueryTree tree(*built);
+    const double radius = tree.nodes()[0].sphere_radius;
+    const RigidTransform pose_a = RigidTransform::identity();
+    const RigidTransform turned{Eigen::AngleAxisd(0.3, Vec3(0, 0, 1)).toRotationMatrix(), Vec3::Zero()};
+    // A turn about the root sphere's centre keeps the centres together.
+    const Vec3 centre = tree.nodes()[0].center;
+    const RigidTransform concentric{turned.rotation, centre - turned.rotation * centre + Vec3(0.2 * radius, 0, 0)};
+    const RigidTransform aside{turned.rotation, concentric.translation + Vec3(0.4 * radius, 0, 0)};
+    for (const bool together : {true, false}) {
+        const RigidTransform& pose_b = together ? concentric : aside;
+        const CollideResult result = collide(tree, pose_a, tree, pose_b, CollideMode::all);
+        EXPECT_EQ(result.pairs, brute_force(*built, pose_a, *built, pose_b));
+        EXPECT_FALSE(result.pairs.empty());
+        if (together) {
+            EXPECT_EQ(result.bv_tests, 1u);
+            EXPECT_EQ(result.primitive_tests, primitives.size() * primitives.size());
+        } else {
+            EXPECT_GT(result.bv_tests, 1u);
+        }
+        CollideResult descended;
+        collide(tree, pose_a, tree, pose_b, CollideMode::all, descended, 0);
+        EXPECT_EQ(descended.pairs, result.pairs);
+        EXPECT_GT(descended.bv_tests, 1u);
+    }
+}
 
 TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
     const Work work = check_builder("deep-mixed", build_deep_mixed);
