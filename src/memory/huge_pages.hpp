@@ -1,13 +1,13 @@
 // SPDX-License-Identifier: MIT
 // Large buffers on 2 MiB pages. A build of 10^6 primitives first-touches about a gigabyte; in 4 KiB pages that
-// is some 300 000 page faults, and on the virtual machines of docs/scale.md §9 ("Page faults") they took 3.4 of
-// `binned`'s 7.8 s; the binary loader saw the same (docs/formats.md). Linux backs memory with transparent huge
+// is hundreds of thousands of page faults, and on the virtual machine of docs/scale.md §9 ("Page faults") they
+// took 3.4 of `binned`'s 7.8 s; the binary loader saw the same (docs/formats.md). Linux backs memory with transparent huge
 // pages where a program asks for them (madvise) even when they are not on for everything, so the library asks,
 // for its own large buffers.
 #pragma once
 
 #include <cstddef>
-#include <new>
+#include <memory>
 #include <vector>
 
 namespace hbvh::detail {
@@ -17,8 +17,8 @@ inline constexpr std::size_t huge_page_advice_min_bytes = std::size_t{4} << 20;
 
 /// Asks the kernel to back the whole 2 MiB pages inside [data, data + bytes) with huge pages: Linux's
 /// madvise(MADV_HUGEPAGE), nothing elsewhere or below huge_page_advice_min_bytes. Advice only: it changes no
-/// value, and a refusal (no THP in the kernel, a region not from mmap) is ignored. Call it before the memory
-/// is first written, since a page already touched stays small.
+/// value, and a refusal (a kernel without transparent huge pages) is ignored. Call it before the memory is
+/// first written, since a page already touched stays small.
 void advise_huge_pages(void* data, std::size_t bytes) noexcept;
 
 /// std::allocator, except that every large allocation is advised (advise_huge_pages). For the builders'
@@ -28,7 +28,7 @@ struct HugePageAllocator {
     using value_type = T;
     HugePageAllocator() = default;
     template <class U>
-    explicit HugePageAllocator(const HugePageAllocator<U>& /*other*/) noexcept {}
+    HugePageAllocator(const HugePageAllocator<U>& /*other*/) noexcept {}  // NOLINT: allocators convert implicitly
 
     [[nodiscard]] T* allocate(std::size_t count) {
         T* data = std::allocator<T>().allocate(count);
