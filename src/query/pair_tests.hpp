@@ -99,6 +99,15 @@ inline double query_slack(const QueryTree& a, const QueryTree& b, const RigidTra
     return face_axis_slack * (2.0 * (centres + motion) + a.extent_bound() + b.extent_bound());
 }
 
+/// The roots' test of both queries: b's root moved by t against a's root, enclosing spheres then enclosing
+/// boxes (boxes_meet with the query's slack).
+inline bool roots_overlap(const QueryTree& a, const QueryTree& b, const RigidTransform& t, double slack) {
+    const QueryNode& x = a.nodes()[0];
+    const QueryNode& y = b.nodes()[0];
+    Placed placed(y, t);
+    return spheres_meet(x, placed.center(), y.sphere_radius) && boxes_meet(x, y, placed, slack);
+}
+
 /// b's leaves moved into a's frame, each at most once per query: their centres for the sphere test and
 /// their exact BVs (moved with transformed(), so that leaf tests match a brute force written with it bit
 /// for bit). Direct-mapped by node index into at most `max_slots` slots: a tree of up to that many nodes

@@ -118,8 +118,7 @@ private:
             return false;
         }
         ++result_.bv_tests;
-        Placed placed(y, t_);
-        return detail::spheres_meet(x, placed.center(), y.sphere_radius) && detail::boxes_meet(x, y, placed, slack_);
+        return detail::roots_overlap(a_, b_, t_, slack_);
     }
 
     /// The roots hold at most the mode's concentric limit of leaf pairs and their enclosing spheres nearly share

@@ -25,9 +25,7 @@ void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const Q
         return;
     }
     ++result.bv_tests;
-    detail::Placed root_b(nb[0], t);
-    if (!detail::spheres_meet(na[0], root_b.center(), nb[0].sphere_radius) || !detail::boxes_meet(na[0], nb[0], root_b, detail::query_slack(a, b, t, t.inverse())))
-        return;
+    if (!detail::roots_overlap(a, b, t, detail::query_slack(a, b, t, t.inverse()))) return;
     result.nodes_visited = 1;
     // Every primitive pair, each of b's primitives moved once, with the same leaf test as tandem traversal
     // so that the comparison measures the hierarchy, not the pair test.
