@@ -35,9 +35,18 @@ std::string first_of(Problems&&... problems) {
     return result;
 }
 
+/// The criterion of a proper rotation, for rotation_problem and is_rigid_motion alike: finite, orthonormal and
+/// of determinant 1, each within rotation_tolerance.
+bool is_rotation(const Mat3& r) {
+    return r.allFinite() && (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff() <= rotation_tolerance &&
+           std::abs(r.determinant() - 1.0) <= rotation_tolerance;
+}
+
 }  // namespace
 
 std::string rotation_problem(const Mat3& rotation) {
+    if (is_rotation(rotation)) return {};
+    // Which condition failed, in the order of is_rotation, with its number.
     if (!rotation.allFinite()) return "rotation is not finite";
     const double orthogonality = (rotation.transpose() * rotation - Mat3::Identity()).cwiseAbs().maxCoeff();
     if (!(orthogonality <= rotation_tolerance))
@@ -90,13 +99,7 @@ Status validate_primitives(std::span<const Primitive> primitives) {
     return Ok{};
 }
 
-bool is_rigid_motion(const RigidTransform& pose) {
-    // The same three conditions as rotation_problem(), in the same arithmetic, so that the two never disagree.
-    const Mat3& r = pose.rotation;
-    return pose.translation.allFinite() && r.allFinite() &&
-           (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff() <= rotation_tolerance &&
-           std::abs(r.determinant() - 1.0) <= rotation_tolerance;
-}
+bool is_rigid_motion(const RigidTransform& pose) { return pose.translation.allFinite() && is_rotation(pose.rotation); }
 
 Status validate_pose(const RigidTransform& pose) {
     if (is_rigid_motion(pose)) return Ok{};
