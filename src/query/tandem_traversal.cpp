@@ -4,6 +4,7 @@
 #include "hbvh/query/tandem_traversal.hpp"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "pair_tests.hpp"
 
@@ -25,6 +26,11 @@ using detail::Placed;
 constexpr double concentric_fraction = 0.5;
 constexpr std::uint64_t concentric_pair_limit_all = 1024;
 constexpr std::uint64_t concentric_pair_limit_first = 4096;
+/// Above the limit, mode first still tries this many leaf pairs of concentric roots before it descends: where
+/// copies overlap, the first leaf of b nearly always meets one of a's first leaves (depth-first order keeps
+/// neighbours together), and a probe that finds nothing costs a bounded few leaf tests (docs/queries.md,
+/// "Concentric roots").
+constexpr std::uint64_t concentric_probe_pairs = 64;
 
 /// One query: the two trees, b's motion into a's frame and back, and where the answer goes.
 class Traversal {
@@ -38,9 +44,14 @@ public:
     void run() {
         if (!roots_meet()) return;
         if (flat_limit_ != 0 && roots_concentric()) {
-            result_.nodes_visited = 1;
-            flat(na_[0], nb_[0]);
-            return;
+            const std::uint64_t pairs = std::uint64_t{na_[0].leaf_count} * nb_[0].leaf_count;
+            const bool first = mode_ == CollideMode::first;
+            if (pairs <= (first ? concentric_pair_limit_first : concentric_pair_limit_all)) {
+                result_.nodes_visited = 1;
+                flat(na_[0], nb_[0]);
+                return;
+            }
+            if (first && flat(na_[0], nb_[0], concentric_probe_pairs)) return;
         }
         // Depth-first over overlapping pairs. Every pair on the stack is known to overlap, and no pair of
         // leaves is ever pushed: those are reported when their test passes. In mode all the stack holds at
@@ -121,26 +132,26 @@ private:
         return detail::roots_overlap(a_, b_, t_, slack_);
     }
 
-    /// The roots hold at most the mode's concentric limit of leaf pairs and their enclosing spheres nearly share
-    /// a centre.
+    /// The roots' enclosing spheres nearly share a centre.
     [[nodiscard]] bool roots_concentric() const {
         const QueryNode& x = na_[0];
         const QueryNode& y = nb_[0];
-        const std::uint64_t limit = mode_ == CollideMode::first ? concentric_pair_limit_first : concentric_pair_limit_all;
-        if (std::uint64_t{x.leaf_count} * y.leaf_count > limit) return false;
         const Vec3 placed = t_.rotation * y.center + t_.translation;
         const double reach = concentric_fraction * std::min(x.sphere_radius, y.sphere_radius);
         return (placed - x.center).squaredNorm() <= reach * reach;
     }
 
-    /// Every leaf of x against every leaf of y; true when the query is answered (mode first).
-    bool flat(const QueryNode& x, const QueryNode& y) {
+    /// Every leaf of x against every leaf of y, or the first `budget` of those pairs; true when the query is
+    /// answered (mode first).
+    bool flat(const QueryNode& x, const QueryNode& y, std::uint64_t budget = UINT64_MAX) {
         const std::span<const std::uint32_t> leaves_a = a_.leaves().subspan(x.leaf_begin, x.leaf_count);
         const std::span<const std::uint32_t> leaves_b = b_.leaves().subspan(y.leaf_begin, y.leaf_count);
         for (const std::uint32_t leaf_b : leaves_b) {
             const Vec3 center_b = moved_.center(leaf_b);
-            for (const std::uint32_t leaf_a : leaves_a)
+            for (const std::uint32_t leaf_a : leaves_a) {
+                if (budget-- == 0) return false;
                 if (leaf_pair(leaf_a, leaf_b, center_b) && found(leaf_a, leaf_b)) return true;
+            }
         }
         return false;
     }

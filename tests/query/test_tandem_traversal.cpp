@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <functional>
 #include <limits>
@@ -260,6 +261,58 @@ TEST(TandemTraversal, ConcentricRootsAreTestedLeafByLeaf) {
         collide(tree, pose_a, tree, pose_b, CollideMode::all, descended, 0);
         EXPECT_EQ(descended.pairs, result.pairs);
         EXPECT_GT(descended.bv_tests, 1u);
+    }
+}
+
+/// Spheres of radius `radius` on a circle of radius 10 about the origin in the z = 0 plane, at the angles
+/// 2 pi (i + offset) / 100.
+std::vector<Primitive> ring(std::uint32_t count, double offset, double radius) {
+    std::vector<Primitive> spheres;
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const double angle = 2.0 * 3.14159265358979323846 * (i + offset) / 100.0;
+        spheres.push_back({Sphere{Vec3(10.0 * std::cos(angle), 10.0 * std::sin(angle), 0.0), radius}, ""});
+    }
+    return spheres;
+}
+
+TEST(TandemTraversal, LargeConcentricRootsAreProbedLeafByLeafInModeFirst) {
+    // Above the concentric rule's limit (100 x 100 leaf pairs), mode first tries a few leaf pairs before it
+    // descends: copies on top of each other then meet at once, with the roots' test the only inner one.
+    const std::vector<Primitive> primitives = generate_scene({.count = 100, .seed = 21});
+    const Bvh bvh = build(primitives, Algorithm::split).value();
+    const QueryTree tree(bvh);
+    const Vec3 centre = tree.nodes()[0].center;
+    const Mat3 turn = Eigen::AngleAxisd(0.05, Vec3(0, 0, 1)).toRotationMatrix();
+    const RigidTransform concentric{turn, centre - turn * centre};
+    const Pairs all = brute_force(bvh, RigidTransform::identity(), bvh, concentric);
+    ASSERT_FALSE(all.empty());
+    const CollideResult first = collide(tree, RigidTransform::identity(), tree, concentric, CollideMode::first);
+    ASSERT_EQ(first.pairs.size(), 1u);
+    EXPECT_TRUE(std::binary_search(all.begin(), all.end(), first.pairs.front()));
+    EXPECT_EQ(first.bv_tests, 1u);
+    EXPECT_LE(first.primitive_tests, 64u);
+    // Mode all keeps its limit (1024 pairs) and descends.
+    const CollideResult every = collide(tree, RigidTransform::identity(), tree, concentric, CollideMode::all);
+    EXPECT_EQ(every.pairs, all);
+    EXPECT_GT(every.bv_tests, 1u);
+
+    // Two concentric rings, a's 100 spheres interleaved with b's 41, which meet a's only where b's sphere 20
+    // is moved onto a's sphere 20 (and b's central sphere meets nothing): the probe's pairs all miss, and the
+    // descent must still find the one contact, or none once it is moved away again.
+    const std::vector<Primitive> ring_a = ring(100, 0.0, 0.1);
+    std::vector<Primitive> ring_b = ring(41, 0.5, 0.1);
+    ring_b.push_back({Sphere{Vec3::Zero(), 2.0}, ""});
+    const Bvh tree_a = build(ring_a, Algorithm::split).value();
+    for (const bool touching : {true, false}) {
+        ring_b[20].volume = ring(21, touching ? 0.0 : 0.5, 0.1)[20].volume;
+        const Bvh tree_b = build(ring_b, Algorithm::split).value();
+        const Pairs expected = brute_force(tree_a, RigidTransform::identity(), tree_b, RigidTransform::identity());
+        ASSERT_EQ(expected.size(), touching ? 1u : 0u);
+        const CollideResult probed = collide(QueryTree(tree_a), RigidTransform::identity(), QueryTree(tree_b),
+                                             RigidTransform::identity(), CollideMode::first);
+        EXPECT_EQ(probed.pairs, expected) << touching;
+        EXPECT_GT(probed.bv_tests, 1u) << touching;  // the probe did not answer: the descent did
+        EXPECT_GE(probed.primitive_tests, 64u) << touching;
     }
 }
 
