@@ -4,7 +4,6 @@
 #include "hbvh/query/tandem_traversal.hpp"
 
 #include <algorithm>
-#include <cstdint>
 
 #include "pair_tests.hpp"
 
@@ -51,7 +50,7 @@ public:
                 flat(na_[0], nb_[0]);
                 return;
             }
-            if (first && flat(na_[0], nb_[0], concentric_probe_pairs)) return;
+            if (first && probe_roots(concentric_probe_pairs)) return;
         }
         // Depth-first over overlapping pairs. Every pair on the stack is known to overlap, and no pair of
         // leaves is ever pushed: those are reported when their test passes. In mode all the stack holds at
@@ -141,15 +140,26 @@ private:
         return (placed - x.center).squaredNorm() <= reach * reach;
     }
 
-    /// Every leaf of x against every leaf of y, or the first `budget` of those pairs; true when the query is
-    /// answered (mode first).
-    bool flat(const QueryNode& x, const QueryNode& y, std::uint64_t budget = UINT64_MAX) {
+    /// Every leaf of x against every leaf of y; true when the query is answered (mode first).
+    bool flat(const QueryNode& x, const QueryNode& y) {
         const std::span<const std::uint32_t> leaves_a = a_.leaves().subspan(x.leaf_begin, x.leaf_count);
         const std::span<const std::uint32_t> leaves_b = b_.leaves().subspan(y.leaf_begin, y.leaf_count);
         for (const std::uint32_t leaf_b : leaves_b) {
             const Vec3 center_b = moved_.center(leaf_b);
+            for (const std::uint32_t leaf_a : leaves_a)
+                if (leaf_pair(leaf_a, leaf_b, center_b) && found(leaf_a, leaf_b)) return true;
+        }
+        return false;
+    }
+
+    /// The first `count` pairs of flat(root, root), in its order; true when one meets (mode first only). Its own
+    /// loop: a budget counted in flat()'s would tax every flat pair of the descent (3-8 % on the partial rows).
+    bool probe_roots(std::uint64_t count) {
+        const std::span<const std::uint32_t> leaves_a = a_.leaves(), leaves_b = b_.leaves();
+        for (const std::uint32_t leaf_b : leaves_b) {
+            const Vec3 center_b = moved_.center(leaf_b);
             for (const std::uint32_t leaf_a : leaves_a) {
-                if (budget-- == 0) return false;
+                if (count-- == 0) return false;
                 if (leaf_pair(leaf_a, leaf_b, center_b) && found(leaf_a, leaf_b)) return true;
             }
         }
