@@ -323,19 +323,6 @@ public:
         at_ += 8 * n;
         return true;
     }
-    /// Skips one volume record, with the checks and problems of volume() but without decoding it.
-    bool skip_volume_checked(std::string& problem) {
-        if (!has(1)) return (problem = "the file ends inside a volume record"), false;
-        const std::uint8_t kind = data_[at_];
-        if (kind >= bv_type_count) {
-            problem = "unknown volume kind " + std::to_string(kind) + " (expected 0 aabb, 1 obb, 2 sphere or 3 capsule)";
-            return false;
-        }
-        ++at_;
-        if (!has(8 * binary_double_count[kind])) return (problem = "the file ends inside a volume record"), false;
-        at_ += 8 * binary_double_count[kind];
-        return true;
-    }
     /// Skips one volume record whose kind is known to be valid (the records were parsed once already).
     void skip_volume() { at_ += 1 + 8 * binary_double_count[data_[at_]]; }
     void skip(std::size_t n) { at_ += n; }
