@@ -91,12 +91,8 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
     // A regular file is read straight into a string of its size: growing a string chunk by chunk would copy
     // a large file several times over.
     std::string content;
-    if (S_ISREG(info.st_mode) && info.st_size > 0) {
-        const auto size = static_cast<std::size_t>(info.st_size);
-        content.reserve(size);
-        detail::advise_huge_pages(content.data(), size);  // before the first write: see memory/huge_pages.hpp
-        content.resize(size);
-    }
+    if (S_ISREG(info.st_mode) && info.st_size > 0)
+        detail::resize_on_huge_pages(content, static_cast<std::size_t>(info.st_size));
     std::size_t filled = 0;
     while (filled < content.size()) {
         const ssize_t count = read_some(file.get(), content.data() + filled, content.size() - filled);

@@ -8,6 +8,7 @@
 
 #include <cstddef>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace hbvh::detail {
@@ -52,6 +53,14 @@ template <class T, class Allocator>
 void reserve_on_huge_pages(std::vector<T, Allocator>& vector, std::size_t count) {
     vector.reserve(count);
     advise_huge_pages(vector.data(), vector.capacity() * sizeof(T));
+}
+
+/// An empty string resized to `size` (zeros), its buffer advised before the zeros are written: for a file's
+/// bytes read into it, or a format written into it.
+inline void resize_on_huge_pages(std::string& text, std::size_t size) {
+    text.reserve(size);
+    advise_huge_pages(text.data(), text.capacity());
+    text.resize(size);
 }
 
 }  // namespace hbvh::detail

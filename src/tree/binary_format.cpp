@@ -527,9 +527,7 @@ std::string write_binary(const Bvh& bvh) {
     for (const Node& node : bvh.nodes) size += volume_record_size(node.volume) + binary_node_links_size;
     for (const Primitive& primitive : bvh.primitives) size += volume_record_size(primitive.volume) + 4 + primitive.name.size();
     std::string out;
-    out.reserve(size);
-    detail::advise_huge_pages(out.data(), size);  // before the first write: see memory/huge_pages.hpp
-    out.resize(size);
+    detail::resize_on_huge_pages(out, size);
     auto* data = reinterpret_cast<unsigned char*>(out.data());
     BinaryWriter writer(data);
 
@@ -646,13 +644,11 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
     auto decode_nodes = [&] {
         if (concurrent && !(corrupted = checksum_problem()).empty()) return;
         // reserve and append rather than resize: the (large) arrays are then written once, not zeroed first.
-        bvh.nodes.reserve(node_count);
-        detail::advise_huge_pages(bvh.nodes.data(), node_count * sizeof(Node));
+        detail::reserve_on_huge_pages(bvh.nodes, node_count);
         nodes_outcome = decode_node_records(data, checksum_at, node_count, primitive_count, bvh.nodes);
     };
     auto decode_primitives = [&] {
-        bvh.primitives.reserve(primitive_count);
-        detail::advise_huge_pages(bvh.primitives.data(), primitive_count * sizeof(Primitive));
+        detail::reserve_on_huge_pages(bvh.primitives, primitive_count);
         primitives_outcome = decode_primitive_records(data, checksum_at, node_count, primitive_count, bvh.primitives);
     };
     if (concurrent) tbb::parallel_invoke(decode_nodes, decode_primitives);
