@@ -84,8 +84,7 @@ PrimitiveSet::PrimitiveSet(std::span<const Primitive> primitives, std::vector<st
     HBVH_ASSERT(order_.size() == primitives.size());
     // Every array at its final size before the first write: no regrowth, and large inputs on huge pages.
     std::size_t sphere_count = 0;
-    for (const Primitive& p : primitives)
-        sphere_count += std::holds_alternative<Sphere>(p.volume) ? 1 : std::holds_alternative<Capsule>(p.volume) ? 2 : 8;
+    for (const Primitive& p : primitives) sphere_count += generating_sphere_count(p.volume);
     reserve_on_huge_pages(spheres_, sphere_count);
     reserve_on_huge_pages(sphere_begin_, order_.size() + 1);
     reserve_on_huge_pages(centres_, order_.size());

@@ -129,6 +129,12 @@ void append_generating_spheres(const BoundingVolume& bv, std::vector<Sphere>& ou
                bv);
 }
 
+std::size_t generating_sphere_count(const BoundingVolume& bv) {
+    return std::visit(Overloaded{[](const Aabb&) -> std::size_t { return 8; }, [](const Obb&) -> std::size_t { return 8; },
+                                 [](const Sphere&) -> std::size_t { return 1; }, [](const Capsule&) -> std::size_t { return 2; }},
+                      bv);
+}
+
 std::vector<Sphere> generating_spheres(const BoundingVolume& bv) {
     std::vector<Sphere> out;
     append_generating_spheres(bv, out);

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <optional>
 #include <string_view>
@@ -69,6 +70,8 @@ inline constexpr std::array<BvType, bv_type_count> all_bv_types{BvType::aabb, Bv
 /// Box -> its 8 corners as radius-0 spheres; sphere -> itself; capsule -> its two end spheres.
 /// Because every BV kind is convex, a convex BV contains the BV iff it contains these spheres.
 void append_generating_spheres(const BoundingVolume& bv, std::vector<Sphere>& out);
+/// How many spheres append_generating_spheres appends for `bv` (8, 8, 1, 2 by kind): to size a buffer first.
+[[nodiscard]] std::size_t generating_sphere_count(const BoundingVolume& bv);
 [[nodiscard]] std::vector<Sphere> generating_spheres(const BoundingVolume& bv);
 
 }  // namespace hbvh
