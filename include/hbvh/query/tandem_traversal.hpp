@@ -128,7 +128,8 @@ inline constexpr std::uint64_t default_flat_pair_limit = 32;
 /// boxes by their six face axes), which never drops a pair but may expand a few more; a pair of subtrees
 /// with at most `flat_pair_limit` leaf pairs is tested leaf by leaf, and so are two small trees whose roots
 /// nearly share a centre (copies on top of each other, where the survey's Two-Level query wins; at most 1024
-/// leaf pairs, 4096 in mode first; docs/queries.md, "Concentric roots"). 0: always descend. pose_a / pose_b
+/// leaf pairs, 4096 in mode first; larger ones get 64 leaf pairs tried before the descent in mode first;
+/// docs/queries.md, "Concentric roots"). 0: always descend. pose_a / pose_b
 /// map each tree's model frame to the world. Each of b's leaves is moved into a's frame at most once per
 /// query, into a per-thread scratch that grows once to min(b's nodes, 4096) slots; nothing else allocates
 /// except growing `result.pairs` (and a heap stack when the two trees' stack bounds add up to more than
