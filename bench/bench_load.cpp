@@ -8,6 +8,7 @@
 //
 //   hbvh_bench --benchmark_filter='load_.*/20k'   (a split tree over 20 000 primitives, a second)
 //   hbvh_bench --benchmark_filter='load_.*/1M'    (a two-level tree over 10^6 primitives; the XML takes seconds)
+// load_binary_query_tree/1M adds the conversion to the query layout: what a program waits for before its first query.
 //
 // Reading and writing a large primitive set (docs/formats.md, "Reading and writing large XML"): the survey's flat
 // format, 10^6 primitives of `generate_scene` (about 230 MB, what `hbvh generate --count 1000000` writes). Rows, in
@@ -34,6 +35,7 @@
 #include "hbvh/builders/build.hpp"
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/xml.hpp"
+#include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/binary_format.hpp"
 
@@ -149,6 +151,33 @@ void load_binary(benchmark::State& state, std::uint32_t count) {
         state.counters["speedup_vs_xml"] = xml->second / (seconds / static_cast<double>(state.iterations()));
 }
 
+/// What a program that loads a tree at start-up to query it waits for: the .hbvh read and its conversion to
+/// the query layout (QueryTree::create, which checks the structure again). Counters: convert_ms, the
+/// conversion's share; speedup_vs_xml, (XML load + conversion) / this row.
+void load_binary_query_tree(benchmark::State& state, std::uint32_t count) {
+    Result<StoredTree> tree = stored_trees().get(count);
+    if (!tree) return fail(state, tree.error().to_string());
+    std::size_t loaded_nodes = 0;
+    benchmark::DoNotOptimize(read_binary_file(tree->binary));  // untimed warm-up, as for the other rows
+    double convert_seconds = 0.0;
+    const auto start = std::chrono::steady_clock::now();
+    for (auto _ : state) {
+        Result<Bvh> bvh = read_binary_file(tree->binary);
+        if (!bvh) return fail(state, bvh.error().to_string());
+        const auto read = std::chrono::steady_clock::now();
+        Result<QueryTree> query_tree = QueryTree::create(*bvh);
+        convert_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - read).count();
+        loaded_nodes = query_tree ? query_tree->nodes().size() : 0;
+        benchmark::DoNotOptimize(loaded_nodes);
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (loaded_nodes != tree->nodes) return fail(state, "the .hbvh file did not convert to the tree written");
+    const auto iterations = static_cast<double>(state.iterations());
+    state.counters["convert_ms"] = 1e3 * convert_seconds / iterations;
+    if (const auto xml = xml_seconds().find(count); xml != xml_seconds().end())
+        state.counters["speedup_vs_xml"] = (xml->second + convert_seconds / iterations) / (seconds / iterations);
+}
+
 /// The 10^6-primitive set on disk, written once per process into the same temporary directory.
 struct StoredSet {
     std::filesystem::path xml;
@@ -234,6 +263,7 @@ BENCHMARK_CAPTURE(load_xml, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterat
 BENCHMARK_CAPTURE(load_binary, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(20);
 BENCHMARK_CAPTURE(load_xml, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK_CAPTURE(load_binary, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
+BENCHMARK_CAPTURE(load_binary_query_tree, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK(pugixml_inplace)->Name("pugixml_inplace/1M")->Unit(benchmark::kMillisecond)->Iterations(3)->UseManualTime();
 BENCHMARK(read_xml_set)->Name("read_xml_set/1M")->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(write_xml_set)->Name("write_xml_set/1M")->Unit(benchmark::kMillisecond)->Iterations(2);

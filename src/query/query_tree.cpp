@@ -2,7 +2,10 @@
 // QueryTree: the read-only layout queries run on, converted once from a Bvh.
 #include <algorithm>
 
+#include <tbb/parallel_invoke.h>
+
 #include "../fit/frames.hpp"
+#include "../memory/huge_pages.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -16,6 +19,9 @@ namespace {
 // radius + |centre|_1, dominates both and the exact tests' own slacks (<= 1e-13 of the coordinates,
 // geometry/overlap.cpp).
 constexpr double stand_in_padding = 1e-12;
+
+// Trees from this many nodes on are converted by two tasks (below, a second task costs more than it saves).
+constexpr std::uint32_t concurrent_conversion_nodes = 1u << 14;
 
 // The traversal reads one node per test: keep it compact (docs/queries.md, "Query layout").
 static_assert(sizeof(QueryNode) == 160);
@@ -82,39 +88,58 @@ Result<QueryTree> QueryTree::create(const Bvh& bvh) {
 }
 
 QueryTree::QueryTree(const Bvh& bvh, Checked) {
-    nodes_.reserve(bvh.nodes.size());
-    volumes_.reserve(bvh.nodes.size());
-    primitive_nodes_.assign(bvh.primitives.size(), 0);
-    std::vector<std::uint32_t> path_sum(bvh.nodes.size(), 0);
-    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
-        const Node& node = bvh.nodes[i];
-        QueryNode q;
-        set_stand_ins(node.volume, q);
-        q.measure = hbvh::volume(node.volume);
-        q.first_child = node.first_child;
-        q.child_count = node.child_count;
-        q.primitive = node.primitive;
-        q.type = type_of(node.volume);
-        coordinate_bound_ = std::max(coordinate_bound_, q.center.cwiseAbs().sum());
-        extent_bound_ = std::max(extent_bound_, q.half_extents.sum());
-        nodes_.push_back(q);
-        volumes_.push_back(node.volume);
-        if (node.is_leaf()) {
-            HBVH_ASSERT(node.primitive < primitive_nodes_.size());
-            primitive_nodes_[node.primitive] = i;
+    // Huge pages for the large arrays: a tree loaded at start-up is converted once, and at 10^6 primitives its
+    // 300 MB in 4 KiB pages cost most of a second in page faults on the machine of docs/formats.md.
+    const auto node_count = static_cast<std::uint32_t>(bvh.nodes.size());
+    detail::reserve_on_huge_pages(nodes_, node_count);
+    detail::reserve_on_huge_pages(volumes_, node_count);
+    // Two independent passes over the Bvh, each writing its own arrays and bounds (so the result does not
+    // depend on the thread count): the nodes' stand-ins, and the exact volumes with the links.
+    auto convert_nodes = [&] {
+        for (const Node& node : bvh.nodes) {
+            QueryNode q;
+            set_stand_ins(node.volume, q);
+            q.measure = hbvh::volume(node.volume);
+            q.first_child = node.first_child;
+            q.child_count = node.child_count;
+            q.primitive = node.primitive;
+            q.type = type_of(node.volume);
+            coordinate_bound_ = std::max(coordinate_bound_, q.center.cwiseAbs().sum());
+            extent_bound_ = std::max(extent_bound_, q.half_extents.sum());
+            nodes_.push_back(q);
         }
-        // Nodes are breadth-first, so a parent's path sum is final before its children are reached.
-        for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) {
-            HBVH_ASSERT(c > i && c < bvh.nodes.size());
-            path_sum[c] = path_sum[i] + node.child_count;
+    };
+    auto copy_volumes_and_links = [&] {
+        detail::reserve_on_huge_pages(primitive_nodes_, bvh.primitives.size());
+        primitive_nodes_.resize(bvh.primitives.size(), 0);
+        std::vector<std::uint32_t> path_sum;
+        detail::reserve_on_huge_pages(path_sum, node_count);
+        path_sum.resize(node_count, 0);
+        for (std::uint32_t i = 0; i < node_count; ++i) {
+            const Node& node = bvh.nodes[i];
+            volumes_.push_back(node.volume);
+            if (node.is_leaf()) {
+                HBVH_ASSERT(node.primitive < primitive_nodes_.size());
+                primitive_nodes_[node.primitive] = i;
+            }
+            // Nodes are breadth-first, so a parent's path sum is final before its children are reached.
+            for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) {
+                HBVH_ASSERT(c > i && c < node_count);
+                path_sum[c] = path_sum[i] + node.child_count;
+            }
+            stack_bound_ = std::max(stack_bound_, path_sum[i]);
         }
-        stack_bound_ = std::max(stack_bound_, path_sum[i]);
+    };
+    if (node_count >= concurrent_conversion_nodes) tbb::parallel_invoke(convert_nodes, copy_volumes_and_links);
+    else {
+        convert_nodes();
+        copy_volumes_and_links();
     }
     if (nodes_.empty()) return;
     // Leaves in depth-first order (an explicit stack: trees may be as deep as they have primitives), each
     // subtree's range closed once its last leaf is placed: children have larger indices than their parent,
     // so a reverse sweep sums the ranges bottom-up.
-    leaves_.reserve(bvh.primitives.size());
+    detail::reserve_on_huge_pages(leaves_, bvh.primitives.size());
     std::vector<std::uint32_t> pending{0};
     while (!pending.empty()) {
         const std::uint32_t i = pending.back();

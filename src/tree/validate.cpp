@@ -5,10 +5,17 @@
 #include <cstdio>
 #include <string>
 
+#include <tbb/parallel_invoke.h>
+
+#include "../memory/huge_pages.hpp"
 #include "hbvh/geometry/validation.hpp"
 
 namespace hbvh {
 namespace {
+/// Trees from this many nodes on have their primitives and nodes checked by two tasks (below, a second task
+/// costs more than it saves).
+constexpr std::size_t concurrent_check_nodes = std::size_t{1} << 14;
+
 Error node_error(std::uint32_t index, const std::string& problem) {
     return Error{"node " + std::to_string(index) + ": " + problem};
 }
@@ -17,32 +24,46 @@ Error node_error(std::uint32_t index, const std::string& problem) {
 Status check_structure(const Bvh& bvh) {
     if (bvh.nodes.empty()) return bvh.primitives.empty() ? Status{Ok{}} : Status{Error{"hierarchy has no nodes"}};
     if (bvh.nodes.size() >= UINT32_MAX) return Error{"hierarchy has more nodes than 32-bit indices can address"};
-    if (Status primitives = validate_primitives(bvh.primitives); !primitives) return primitives;
     const auto node_count = static_cast<std::uint64_t>(bvh.nodes.size());
-    std::vector<std::uint32_t> leaf_of(bvh.primitives.size(), UINT32_MAX);  // UINT32_MAX = not seen yet
-    // Breadth-first: the inner nodes' child ranges, in index order, follow each other from node 1 on.
-    std::uint64_t next_child = 1;
-    for (std::uint32_t i = 0; i < node_count; ++i) {
-        const Node& node = bvh.nodes[i];
-        if (std::string problem = volume_problem(node.volume); !problem.empty()) return node_error(i, problem);
-        if (node.is_leaf()) {
-            if (node.primitive >= bvh.primitives.size()) return node_error(i, "leaf refers to a missing primitive");
-            if (leaf_of[node.primitive] != UINT32_MAX)
-                return node_error(i, "primitive " + std::to_string(node.primitive) + " appears in two leaves");
-            leaf_of[node.primitive] = i;
-            continue;
+    std::vector<std::uint32_t> leaf_of;
+    auto check_nodes = [&]() -> Status {
+        detail::reserve_on_huge_pages(leaf_of, bvh.primitives.size());
+        leaf_of.resize(bvh.primitives.size(), UINT32_MAX);  // UINT32_MAX = not seen yet
+        // Breadth-first: the inner nodes' child ranges, in index order, follow each other from node 1 on.
+        std::uint64_t next_child = 1;
+        for (std::uint32_t i = 0; i < node_count; ++i) {
+            const Node& node = bvh.nodes[i];
+            if (std::string problem = volume_problem(node.volume); !problem.empty()) return node_error(i, problem);
+            if (node.is_leaf()) {
+                if (node.primitive >= bvh.primitives.size()) return node_error(i, "leaf refers to a missing primitive");
+                if (leaf_of[node.primitive] != UINT32_MAX)
+                    return node_error(i, "primitive " + std::to_string(node.primitive) + " appears in two leaves");
+                leaf_of[node.primitive] = i;
+                continue;
+            }
+            if (node.child_count < 2) return node_error(i, "inner node with a single child");
+            if (std::uint64_t{node.first_child} + node.child_count > node_count)
+                return node_error(i, "child range past the end of the node array");
+            // This also rules out cycles and shared children: every child comes after its parent, once.
+            if (node.first_child != next_child)
+                return node_error(i, "children at " + std::to_string(node.first_child) +
+                                         ", but breadth-first order puts them at " + std::to_string(next_child));
+            next_child += node.child_count;
         }
-        if (node.child_count < 2) return node_error(i, "inner node with a single child");
-        if (std::uint64_t{node.first_child} + node.child_count > node_count)
-            return node_error(i, "child range past the end of the node array");
-        // This also rules out cycles and shared children: every child comes after its parent, once.
-        if (node.first_child != next_child)
-            return node_error(i, "children at " + std::to_string(node.first_child) + ", but breadth-first order puts them at " +
-                                     std::to_string(next_child));
-        next_child += node.child_count;
-    }
-    if (next_child != node_count)
-        return node_error(static_cast<std::uint32_t>(next_child), "is no node's child (nodes are not one breadth-first tree)");
+        if (next_child != node_count)
+            return node_error(static_cast<std::uint32_t>(next_child), "is no node's child (nodes are not one breadth-first tree)");
+        return Ok{};
+    };
+    // The primitives and the nodes are independent checks: a large tree (a loaded 10^6-primitive file) has
+    // them made at once, and the primitives' problem is still the one reported when both have one.
+    Status primitives = Ok{};
+    Status nodes = Ok{};
+    if (bvh.nodes.size() >= concurrent_check_nodes)
+        tbb::parallel_invoke([&] { primitives = validate_primitives(bvh.primitives); }, [&] { nodes = check_nodes(); });
+    else if (primitives = validate_primitives(bvh.primitives); primitives)
+        nodes = check_nodes();
+    if (!primitives) return primitives;
+    if (!nodes) return nodes;
     for (std::uint32_t p = 0; p < bvh.primitives.size(); ++p)
         if (leaf_of[p] == UINT32_MAX) return Error{"primitive " + std::to_string(p) + " is in no leaf"};
     return Ok{};

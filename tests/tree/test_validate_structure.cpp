@@ -89,6 +89,64 @@ TEST(CheckStructure, RefusesBadGeometryInANodeOrAPrimitive) {
     EXPECT_NE(structure_problem(negative).find("primitive 2"), std::string::npos);
 }
 
+/// A two-level tree over `count` unit boxes in a row: the root and one leaf per box.
+Bvh wide_row(std::uint32_t count) {
+    Bvh bvh;
+    for (std::uint32_t i = 0; i < count; ++i) bvh.primitives.push_back(structure_box_at(2.0 * i));
+    bvh.nodes.push_back({Aabb{Vec3(0, 0, 0), Vec3(2.0 * count - 1.0, 1, 1)}, 1, count, 0});
+    for (std::uint32_t i = 0; i < count; ++i) bvh.nodes.push_back({bvh.primitives[i].volume, 0, 0, i});
+    return bvh;
+}
+
+TEST(CheckStructure, LargeTreesReportTheSameProblemsInTheSameOrder) {
+    // From 2^14 nodes the primitives and the nodes are checked by two tasks; the answer must be the one
+    // the sequential order gives: the primitives' problem first, then the nodes', then the leaves' coverage.
+    for (const std::uint32_t count : {100u, 40'000u}) {
+        SCOPED_TRACE(count);
+        EXPECT_EQ(structure_problem(wide_row(count)), "");
+        Bvh both = wide_row(count);
+        both.primitives[count - 3].volume = Sphere{Vec3(0, 0, 0), -1.0};
+        both.nodes[count / 2].volume = Sphere{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), 1.0};
+        EXPECT_EQ(structure_problem(both).rfind("primitive " + std::to_string(count - 3), 0), 0u) << structure_problem(both);
+        Bvh node_only = wide_row(count);
+        node_only.nodes[count / 2].volume = Sphere{Vec3(std::numeric_limits<double>::quiet_NaN(), 0, 0), 1.0};
+        EXPECT_EQ(structure_problem(node_only).rfind("node " + std::to_string(count / 2), 0), 0u) << structure_problem(node_only);
+        Bvh duplicate = wide_row(count);
+        duplicate.nodes[count].primitive = 0;
+        EXPECT_NE(structure_problem(duplicate).find("two leaves"), std::string::npos);
+        Bvh uncovered = wide_row(count);
+        uncovered.primitives.push_back(structure_box_at(-5));
+        EXPECT_EQ(structure_problem(uncovered), "primitive " + std::to_string(count) + " is in no leaf");
+    }
+}
+
+TEST(QueryTree, LargeTreesConvertAsSmallOnesDo) {
+    // From 2^14 nodes the conversion runs as two tasks: the nodes, leaves, bounds and stack bound must be what
+    // a tree with the same shape gives, checked against the Bvh directly.
+    const Bvh bvh = wide_row(40'000);
+    const QueryTree tree(bvh);
+    ASSERT_EQ(tree.nodes().size(), bvh.nodes.size());
+    EXPECT_EQ(tree.stack_bound(), 40'000u);
+    EXPECT_EQ(tree.nodes()[0].leaf_count, 40'000u);
+    EXPECT_DOUBLE_EQ(tree.extent_bound(), tree.nodes()[0].half_extents.sum());
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const QueryNode& q = tree.nodes()[i];
+        ASSERT_EQ(q.first_child, bvh.nodes[i].first_child);
+        ASSERT_EQ(q.child_count, bvh.nodes[i].child_count);
+        const Aabb box = std::get<Aabb>(bvh.nodes[i].volume);
+        const Aabb& copied = std::get<Aabb>(tree.volume(i));
+        ASSERT_TRUE(copied.min == box.min && copied.max == box.max);
+        ASSERT_NEAR((q.center - box.center()).norm(), 0.0, 1e-12);
+        ASSERT_GE(q.sphere_radius, box.half_extents().norm());
+        if (i > 0) {
+            ASSERT_EQ(tree.primitive_nodes()[bvh.nodes[i].primitive], i);
+            ASSERT_EQ(tree.leaves()[q.leaf_begin], i);
+        }
+    }
+    // The farthest centre is the last box's, (2 x 39 999 + 0.5, 0.5, 0.5); the stand-ins' padding is 1e-12 of it.
+    EXPECT_NEAR(tree.coordinate_bound(), 2.0 * 39'999 + 1.5, 1e-6);
+}
+
 /// Largest per-face (boxes) or radial (round volumes) excess of `point` over `bv`, written independently of
 /// protrusion(): boxes through their corners' frame, round volumes through distances.
 double point_excess(const BoundingVolume& bv, const Vec3& point) {
