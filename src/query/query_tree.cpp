@@ -1,13 +1,17 @@
 // SPDX-License-Identifier: MIT
 // QueryTree: the read-only layout queries run on, converted once from a Bvh.
 #include <algorithm>
+#include <optional>
+#include <string>
 
 #include <tbb/parallel_invoke.h>
 
 #include "../fit/frames.hpp"
 #include "../memory/huge_pages.hpp"
+#include "../tree/binary_decoding.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
+#include "hbvh/tree/binary_format.hpp"
 #include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
@@ -87,59 +91,119 @@ Result<QueryTree> QueryTree::create(const Bvh& bvh) {
     return QueryTree(bvh, Checked{});
 }
 
-QueryTree::QueryTree(const Bvh& bvh, Checked) {
-    // Huge pages for the large arrays: a tree loaded at start-up is converted once, and at 10^6 primitives its
-    // 300 MB in 4 KiB pages cost most of a second in page faults on the machine of docs/formats.md.
-    const auto node_count = static_cast<std::uint32_t>(bvh.nodes.size());
-    detail::reserve_on_huge_pages(nodes_, node_count);
+// Huge pages for the large arrays: a tree loaded at start-up is converted once, and at 10^6 primitives its
+// 300 MB in 4 KiB pages cost most of a second in page faults on the machine of docs/formats.md.
+void QueryTree::reserve_stand_ins(std::size_t node_count) { detail::reserve_on_huge_pages(nodes_, node_count); }
+
+void QueryTree::reserve_volumes_and_links(std::size_t node_count, std::size_t primitive_count, LinkState& links) {
     detail::reserve_on_huge_pages(volumes_, node_count);
+    detail::reserve_on_huge_pages(primitive_nodes_, primitive_count);
+    primitive_nodes_.resize(primitive_count, 0);
+    detail::reserve_on_huge_pages(links.path_sum, node_count);
+    links.path_sum.resize(node_count, 0);
+}
+
+void QueryTree::add_stand_ins(const Node& node) {
+    QueryNode q;
+    set_stand_ins(node.volume, q);
+    q.measure = hbvh::volume(node.volume);
+    q.first_child = node.first_child;
+    q.child_count = node.child_count;
+    q.primitive = node.primitive;
+    q.type = type_of(node.volume);
+    coordinate_bound_ = std::max(coordinate_bound_, q.center.cwiseAbs().sum());
+    extent_bound_ = std::max(extent_bound_, q.half_extents.sum());
+    nodes_.push_back(q);
+}
+
+void QueryTree::add_volume_and_links(std::uint32_t i, const Node& node, LinkState& links) {
+    volumes_.push_back(node.volume);
+    std::vector<std::uint32_t>& path_sum = links.path_sum;
+    if (node.is_leaf()) {
+        if (node.primitive < primitive_nodes_.size()) primitive_nodes_[node.primitive] = i;
+    } else if (node.first_child == links.next_child && node.first_child > i &&
+               std::uint64_t{node.first_child} + node.child_count <= path_sum.size()) {
+        // Breadth-first, so a parent's path sum is final before its children are reached.
+        for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c)
+            path_sum[c] = path_sum[i] + node.child_count;
+        links.next_child += node.child_count;
+    } else {
+        links.next_child = UINT64_MAX;  // not breadth-first: refused later; no more links are followed
+    }
+    if (i < path_sum.size()) stack_bound_ = std::max(stack_bound_, path_sum[i]);
+}
+
+QueryTree::QueryTree(const Bvh& bvh, Checked) {
+    const auto node_count = static_cast<std::uint32_t>(bvh.nodes.size());
+    LinkState links;
     // Two independent passes over the Bvh, each writing its own arrays and bounds (so the result does not
     // depend on the thread count): the nodes' stand-ins, and the exact volumes with the links.
     auto convert_nodes = [&] {
-        for (const Node& node : bvh.nodes) {
-            QueryNode q;
-            set_stand_ins(node.volume, q);
-            q.measure = hbvh::volume(node.volume);
-            q.first_child = node.first_child;
-            q.child_count = node.child_count;
-            q.primitive = node.primitive;
-            q.type = type_of(node.volume);
-            coordinate_bound_ = std::max(coordinate_bound_, q.center.cwiseAbs().sum());
-            extent_bound_ = std::max(extent_bound_, q.half_extents.sum());
-            nodes_.push_back(q);
-        }
+        reserve_stand_ins(node_count);
+        for (const Node& node : bvh.nodes) add_stand_ins(node);
     };
     auto copy_volumes_and_links = [&] {
-        detail::reserve_on_huge_pages(primitive_nodes_, bvh.primitives.size());
-        primitive_nodes_.resize(bvh.primitives.size(), 0);
-        std::vector<std::uint32_t> path_sum;
-        detail::reserve_on_huge_pages(path_sum, node_count);
-        path_sum.resize(node_count, 0);
-        for (std::uint32_t i = 0; i < node_count; ++i) {
-            const Node& node = bvh.nodes[i];
-            volumes_.push_back(node.volume);
-            if (node.is_leaf()) {
-                HBVH_ASSERT(node.primitive < primitive_nodes_.size());
-                primitive_nodes_[node.primitive] = i;
-            }
-            // Nodes are breadth-first, so a parent's path sum is final before its children are reached.
-            for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) {
-                HBVH_ASSERT(c > i && c < node_count);
-                path_sum[c] = path_sum[i] + node.child_count;
-            }
-            stack_bound_ = std::max(stack_bound_, path_sum[i]);
-        }
+        reserve_volumes_and_links(node_count, bvh.primitives.size(), links);
+        for (std::uint32_t i = 0; i < node_count; ++i) add_volume_and_links(i, bvh.nodes[i], links);
     };
     if (node_count >= concurrent_conversion_nodes) tbb::parallel_invoke(convert_nodes, copy_volumes_and_links);
     else {
         convert_nodes();
         copy_volumes_and_links();
     }
+    finish();
+}
+
+Result<QueryTree> QueryTree::read_binary(std::span<const std::byte> bytes, std::string_view source_name) {
+    // Each node goes into the query layout as it is decoded; the structure's checks run alongside and decide
+    // at the end (add_volume_and_links is safe on any node meanwhile). One task fills every array: two passes
+    // over the records, each filling half, were no faster on the 2-core machine of docs/formats.md.
+    class IntoQueryTree final : public detail::BinaryNodeSink {
+    public:
+        explicit IntoQueryTree(QueryTree& tree) : tree_(tree) {}
+        void reserve(std::uint64_t node_count, std::uint64_t primitive_count) override {
+            tree_.reserve_stand_ins(node_count);
+            tree_.reserve_volumes_and_links(node_count, primitive_count, links_);
+        }
+        void add(const Node& node) override {
+            tree_.add_stand_ins(node);
+            tree_.add_volume_and_links(next_++, node, links_);
+        }
+
+    private:
+        QueryTree& tree_;
+        LinkState links_;
+        std::uint32_t next_ = 0;
+    };
+    const std::string file(source_name);
+    QueryTree tree;
+    IntoQueryTree sink(tree);
+    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sink, nullptr);
+    if (!decoded) return decoded.error();
+    if (!decoded->sound) {
+        // Something may be wrong: the Bvh reader's full checks decide, and name the problem as it does.
+        Result<Bvh> checked = hbvh::read_binary(bytes, source_name);
+        if (!checked) return checked.error();
+    }
+    if (decoded->node_count == 0)
+        return Error{"holds a primitive set, not a hierarchy: build one (hbvh build) before querying it", file};
+    tree.finish();
+    return tree;
+}
+
+Result<QueryTree> QueryTree::read_binary_file(const std::filesystem::path& path) {
+    std::optional<Result<QueryTree>> tree;
+    const Status read = detail::with_file_bytes(path, [&](std::span<const std::byte> bytes) { tree = read_binary(bytes, path.string()); });
+    if (!read) return read.error();
+    return std::move(*tree);
+}
+
+void QueryTree::finish() {
     if (nodes_.empty()) return;
     // Leaves in depth-first order (an explicit stack: trees may be as deep as they have primitives), each
     // subtree's range closed once its last leaf is placed: children have larger indices than their parent,
     // so a reverse sweep sums the ranges bottom-up.
-    detail::reserve_on_huge_pages(leaves_, bvh.primitives.size());
+    detail::reserve_on_huge_pages(leaves_, primitive_nodes_.size());
     std::vector<std::uint32_t> pending{0};
     while (!pending.empty()) {
         const std::uint32_t i = pending.back();

@@ -17,6 +17,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <system_error>
 #include <vector>
 
@@ -29,6 +30,7 @@
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
 #include "../memory/huge_pages.hpp"
+#include "binary_decoding.hpp"
 
 namespace hbvh {
 namespace {
@@ -399,9 +401,9 @@ struct DecodeOutcome {
     std::size_t records_at = 0;  ///< Where the task's records start (for stage 4's offsets).
 };
 
-/// The node records (they follow the header) into `nodes`, with check_structure()'s tests made on the way.
+/// The node records (they follow the header) handed to `nodes`, with check_structure()'s tests made on the way.
 DecodeOutcome decode_node_records(const unsigned char* data, std::size_t end, std::uint64_t node_count,
-                                  std::uint64_t primitive_count, std::vector<Node>& nodes) {
+                                  std::uint64_t primitive_count, detail::BinaryNodeSink& nodes) {
     DecodeOutcome outcome;
     outcome.records_at = binary_header_size;
     BinaryReader reader(data, end);
@@ -418,15 +420,15 @@ DecodeOutcome decode_node_records(const unsigned char* data, std::size_t end, st
     std::string problem;
     for (std::uint64_t i = 0; i < node_count; ++i) {
         const std::size_t at = reader.offset();
-        // Decoded on the stack and appended whole: emplace_back() would first clear the node in the (fresh,
-        // uncached) array and then write it again.
-        Node decoded;
-        if (!reader.volume(decoded.volume, problem, sound)) return fail(reader.offset(), problem);
+        // Decoded on the stack and handed over whole: a Bvh's emplace_back() would first clear the node in the
+        // (fresh, uncached) array and then write it again.
+        Node node;
+        if (!reader.volume(node.volume, problem, sound)) return fail(reader.offset(), problem);
         if (!reader.has(binary_node_links_size)) return fail(at, "the file ends inside a node record");
-        decoded.first_child = reader.u32();
-        decoded.child_count = reader.u32();
-        decoded.primitive = reader.u32();
-        const Node& node = nodes.emplace_back(decoded);
+        node.first_child = reader.u32();
+        node.child_count = reader.u32();
+        node.primitive = reader.u32();
+        nodes.add(node);
         if (!sound) continue;
         if (node.is_leaf()) {
             // In range and in no other leaf; with as many leaves as primitives, that is each one once.
@@ -469,9 +471,10 @@ std::size_t skip_node_records(const unsigned char* data, std::size_t end, std::u
     return at;
 }
 
-/// The primitive records and their names into `primitives`, with validate_primitives()'s tests made on the way.
+/// The primitive records and their names into `primitives` (or, when it is null, only read), with
+/// validate_primitives()'s tests made on the way.
 DecodeOutcome decode_primitive_records(const unsigned char* data, std::size_t end, std::uint64_t node_count,
-                                       std::uint64_t primitive_count, std::vector<Primitive>& primitives) {
+                                       std::uint64_t primitive_count, std::vector<Primitive>* primitives) {
     DecodeOutcome outcome;
     auto fail = [&](std::size_t at, std::string problem) {
         outcome.problem = std::move(problem);
@@ -489,19 +492,20 @@ DecodeOutcome decode_primitive_records(const unsigned char* data, std::size_t en
     for (std::uint64_t i = 0; i < primitive_count; ++i) {
         BoundingVolume volume;  // on the stack, then appended whole (as for the nodes)
         if (!reader.volume(volume, problem, outcome.sound)) return fail(reader.offset(), problem);
-        primitives.emplace_back(volume, std::string());
+        if (primitives != nullptr) primitives->emplace_back(volume, std::string());
     }
-    for (Primitive& primitive : primitives) {
+    for (std::uint64_t i = 0; i < primitive_count; ++i) {
         if (!reader.has(4)) return fail(reader.offset(), "the file ends inside the names");
         const std::uint32_t length = reader.u32();
         if (length == 0) continue;
         if (!reader.has(length))
             return fail(reader.offset() - 4, "a name of " + std::to_string(length) + " bytes runs past the end of the file");
         const std::size_t name_at = reader.offset();
-        primitive.name.assign(reader.bytes(length));
-        if (is_plain_ascii(primitive.name)) continue;
+        const std::string_view name = reader.bytes(length);
         std::size_t bad_at = 0;
-        if (std::string bad = utf8_problem(primitive.name, bad_at); !bad.empty()) return fail(name_at + bad_at, bad);
+        if (!is_plain_ascii(name))
+            if (std::string bad = utf8_problem(name, bad_at); !bad.empty()) return fail(name_at + bad_at, bad);
+        if (primitives != nullptr) (*primitives)[i].name.assign(name);
     }
     if (reader.left() != 0)
         return fail(reader.offset(), std::to_string(reader.left()) + " unused bytes between the names and the checksum");
@@ -560,9 +564,14 @@ std::string write_binary(const Bvh& bvh) {
     return out;
 }
 
-Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view source_name) {
-    const std::string file(source_name);
-    auto fail = [&](std::size_t offset, const std::string& problem) -> Result<Bvh> {
+/// Files from this size on are mapped rather than read (below it, one read() is as fast and needs no mapping).
+constexpr std::uint64_t mapped_read_bytes = std::uint64_t{1} << 20;
+
+namespace detail {
+
+Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std::string& file, BinaryNodeSink& nodes,
+                                   std::vector<Primitive>* primitives) {
+    auto fail = [&](std::size_t offset, const std::string& problem) -> Result<DecodedBinary> {
         return Error{"offset " + std::to_string(offset) + ": " + problem, file};
     };
     const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
@@ -629,13 +638,13 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
     // primitive set, validate_primitives()) would check is tested on the fly without composing messages;
     // `sound` stays true only if all of it passed, and then stage 4 has nothing left to find.
     //
-    // In a large file the checksum, the nodes and the primitives are worked on at once by two tasks: one
-    // verifies the checksum and then decodes the nodes, the other decodes the primitives (filling the 300 MB of
-    // a 10^6-primitive Bvh is most of a load, and one core alone leaves half the machine idle). Each array is
-    // written by one task only, front to back, so the result does not depend on the thread count, and the
-    // problem reported is the one a reader going front to back finds first: a checksum mismatch, then the
-    // counts, then the first bad node record, then the first bad primitive record. Before the checksum is
-    // known the counts are only known to be possible for the file's size, which bounds what is allocated.
+    // In a large file the checksum, the nodes and the primitives are three tasks, run at once on the cores
+    // there are (filling the 300 MB of a 10^6-primitive tree is most of a load, and one core alone leaves half
+    // the machine idle). Each output is written by one task only, front to back, so the result does not depend
+    // on the thread count, and the problem reported is the one a reader going front to back finds first: a
+    // checksum mismatch, then the counts, then the first bad node record, then the first bad primitive record.
+    // Before the checksum is known the counts are only known to be possible for the file's size, which bounds
+    // what is allocated.
     constexpr std::size_t concurrent_decode_bytes = std::size_t{1} << 19;  // below, a second task costs more than it saves
     const bool concurrent = size >= concurrent_decode_bytes && count_problem.empty();
     std::string corrupted;
@@ -643,19 +652,16 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
         if (corrupted = checksum_problem(); !corrupted.empty()) return fail(checksum_at, corrupted);
         if (!count_problem.empty()) return fail(count_problem_at, count_problem);
     }
-    Bvh bvh;
     DecodeOutcome nodes_outcome, primitives_outcome;
     auto decode_nodes = [&] {
-        if (concurrent && !(corrupted = checksum_problem()).empty()) return;
-        // reserve and append rather than resize: the (large) arrays are then written once, not zeroed first.
-        detail::reserve_on_huge_pages(bvh.nodes, node_count);
-        nodes_outcome = decode_node_records(data, checksum_at, node_count, primitive_count, bvh.nodes);
+        nodes.reserve(node_count, primitive_count);
+        nodes_outcome = decode_node_records(data, checksum_at, node_count, primitive_count, nodes);
     };
     auto decode_primitives = [&] {
-        detail::reserve_on_huge_pages(bvh.primitives, primitive_count);
-        primitives_outcome = decode_primitive_records(data, checksum_at, node_count, primitive_count, bvh.primitives);
+        if (primitives != nullptr) detail::reserve_on_huge_pages(*primitives, primitive_count);
+        primitives_outcome = decode_primitive_records(data, checksum_at, node_count, primitive_count, primitives);
     };
-    if (concurrent) tbb::parallel_invoke(decode_nodes, decode_primitives);
+    if (concurrent) tbb::parallel_invoke([&] { corrupted = checksum_problem(); }, decode_nodes, decode_primitives);
     else {
         decode_nodes();
         if (nodes_outcome.problem.empty()) decode_primitives();
@@ -663,41 +669,15 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
     if (!corrupted.empty()) return fail(checksum_at, corrupted);
     if (!nodes_outcome.problem.empty()) return fail(nodes_outcome.problem_at, nodes_outcome.problem);
     if (!primitives_outcome.problem.empty()) return fail(primitives_outcome.problem_at, primitives_outcome.problem);
-    const std::size_t primitives_at = primitives_outcome.records_at;
-    const bool sound = nodes_outcome.sound && primitives_outcome.sound;
-    if (sound) return bvh;
-
-    // Stage 4: something failed on the way, so run the same checks as for any other hierarchy, for their
-    // words. Their messages name a node or primitive; the offset of its record is found by walking the
-    // (already parsed, so well-formed) records again.
-    const Status checked = bvh.nodes.empty() ? validate_primitives(bvh.primitives) : check_structure(bvh);
-    if (!checked) {
-        const std::string& message = checked.error().message;
-        std::size_t offset = binary_header_size;
-        if (const long long node = leading_index(message, "node"); node >= 0 && static_cast<std::uint64_t>(node) < node_count) {
-            BinaryReader walk(data, checksum_at);
-            walk.skip(binary_header_size);
-            for (long long i = 0; i < node; ++i) {
-                walk.skip_volume();
-                walk.skip(binary_node_links_size);
-            }
-            offset = walk.offset();
-        } else if (const long long primitive = leading_index(message, "primitive");
-                   primitive >= 0 && static_cast<std::uint64_t>(primitive) < primitive_count) {
-            BinaryReader walk(data, checksum_at);
-            walk.skip(primitives_at);
-            for (long long i = 0; i < primitive; ++i) walk.skip_volume();
-            offset = walk.offset();
-        }
-        return fail(offset, message);
-    }
-    return bvh;
+    DecodedBinary decoded;
+    decoded.node_count = node_count;
+    decoded.primitive_count = primitive_count;
+    decoded.sound = nodes_outcome.sound && primitives_outcome.sound;
+    decoded.primitives_at = primitives_outcome.records_at;
+    return decoded;
 }
 
-/// Files from this size on are mapped rather than read (below it, one read() is as fast and needs no mapping).
-constexpr std::uint64_t mapped_read_bytes = std::uint64_t{1} << 20;
-
-Result<Bvh> read_binary_file(const std::filesystem::path& path) {
+Status with_file_bytes(const std::filesystem::path& path, const std::function<void(std::span<const std::byte>)>& use) {
     const std::string name = path.string();
     const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) return Error{"cannot open for reading: " + describe_errno(errno), name};
@@ -718,9 +698,9 @@ Result<Bvh> read_binary_file(const std::filesystem::path& path) {
         void* mapped = ::mmap(nullptr, length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
         if (mapped != MAP_FAILED) {
             ::close(fd);
-            Result<Bvh> bvh = read_binary(std::span<const std::byte>(static_cast<const std::byte*>(mapped), length), name);
+            use(std::span<const std::byte>(static_cast<const std::byte*>(mapped), length));
             ::munmap(mapped, length);
-            return bvh;
+            return Ok{};
         }
         // Where mapping is refused (some file systems), read it.
     }
@@ -760,7 +740,68 @@ Result<Bvh> read_binary_file(const std::filesystem::path& path) {
     }
     ::close(fd);
     if (failure != 0) return Error{"cannot read: " + describe_errno(failure), name};
-    return read_binary(std::span<const std::byte>(bytes.get(), filled), name);
+    use(std::span<const std::byte>(bytes.get(), filled));
+    return Ok{};
+}
+
+}  // namespace detail
+
+Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view source_name) {
+    const std::string file(source_name);
+    // The nodes appended to the Bvh as decoded (reserve and append rather than resize: the large array is
+    // then written once, not zeroed first).
+    class IntoBvh final : public detail::BinaryNodeSink {
+    public:
+        explicit IntoBvh(std::vector<Node>& nodes) : nodes_(nodes) {}
+        void reserve(std::uint64_t node_count, std::uint64_t /*primitive_count*/) override {
+            detail::reserve_on_huge_pages(nodes_, node_count);
+        }
+        void add(const Node& node) override { nodes_.push_back(node); }
+
+    private:
+        std::vector<Node>& nodes_;
+    };
+    Bvh bvh;
+    IntoBvh sink(bvh.nodes);
+    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sink, &bvh.primitives);
+    if (!decoded) return decoded.error();
+    if (decoded->sound) return bvh;
+
+    // Stage 4: something failed on the way, so run the same checks as for any other hierarchy, for their
+    // words. Their messages name a node or primitive; the offset of its record is found by walking the
+    // (already parsed, so well-formed) records again.
+    const Status checked = bvh.nodes.empty() ? validate_primitives(bvh.primitives) : check_structure(bvh);
+    if (!checked) {
+        const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
+        const std::size_t checksum_at = bytes.size() - binary_checksum_size;
+        const std::string& message = checked.error().message;
+        std::size_t offset = binary_header_size;
+        if (const long long node = leading_index(message, "node");
+            node >= 0 && static_cast<std::uint64_t>(node) < decoded->node_count) {
+            BinaryReader walk(data, checksum_at);
+            walk.skip(binary_header_size);
+            for (long long i = 0; i < node; ++i) {
+                walk.skip_volume();
+                walk.skip(binary_node_links_size);
+            }
+            offset = walk.offset();
+        } else if (const long long primitive = leading_index(message, "primitive");
+                   primitive >= 0 && static_cast<std::uint64_t>(primitive) < decoded->primitive_count) {
+            BinaryReader walk(data, checksum_at);
+            walk.skip(decoded->primitives_at);
+            for (long long i = 0; i < primitive; ++i) walk.skip_volume();
+            offset = walk.offset();
+        }
+        return Error{"offset " + std::to_string(offset) + ": " + message, file};
+    }
+    return bvh;
+}
+
+Result<Bvh> read_binary_file(const std::filesystem::path& path) {
+    std::optional<Result<Bvh>> bvh;
+    const Status read = detail::with_file_bytes(path, [&](std::span<const std::byte> bytes) { bvh = read_binary(bytes, path.string()); });
+    if (!read) return read.error();
+    return std::move(*bvh);
 }
 
 Status write_binary_file(const std::filesystem::path& path, const Bvh& bvh) {

@@ -1,9 +1,11 @@
 // SPDX-License-Identifier: MIT
 // The .hbvh binary format: round trips of trees from several builders, names in UTF-8, primitive sets and
 // single leaves; every truncation and every single-byte corruption refused; recomputed checksums leave only
-// valid trees; versions, magic, counts and the file helpers.
+// valid trees; versions, magic, counts and the file helpers. Every read is also made by QueryTree::read_binary,
+// which must refuse the same bytes with the same words and otherwise give the tree the Bvh converts to.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <bit>
 #include <cstring>
 #include <filesystem>
@@ -19,6 +21,7 @@
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/binary_format.hpp"
 #include "hbvh/geometry/validation.hpp"
+#include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/tree/validate.hpp"
 #include "support/tree_properties.hpp"
 
@@ -27,7 +30,46 @@ namespace {
 
 std::span<const std::byte> as_span(const std::string& bytes) { return std::as_bytes(std::span(bytes)); }
 
-Result<Bvh> read(const std::string& bytes) { return read_binary(as_span(bytes), "test.hbvh"); }
+/// QueryTree::read_binary, which decodes straight into the query layout, against read_binary and then the
+/// conversion of its Bvh: the same refusals with the same words, and otherwise the same query tree.
+void expect_query_tree_agrees(const std::string& bytes, const Result<Bvh>& bvh) {
+    const Result<QueryTree> direct = QueryTree::read_binary(as_span(bytes), "test.hbvh");
+    if (!bvh) {
+        ASSERT_FALSE(direct.has_value());
+        EXPECT_EQ(direct.error().to_string(), bvh.error().to_string());
+        return;
+    }
+    if (bvh->nodes.empty()) {  // a primitive set: nothing to query
+        ASSERT_FALSE(direct.has_value());
+        EXPECT_NE(direct.error().message.find("primitive set"), std::string::npos) << direct.error().message;
+        return;
+    }
+    ASSERT_TRUE(direct.has_value()) << direct.error().to_string();
+    const QueryTree converted(*bvh);
+    ASSERT_EQ(direct->nodes().size(), converted.nodes().size());
+    for (std::uint32_t i = 0; i < converted.nodes().size(); ++i) {
+        const QueryNode& a = direct->nodes()[i];
+        const QueryNode& b = converted.nodes()[i];
+        ASSERT_TRUE(a.center == b.center && a.sphere_radius == b.sphere_radius && a.rotation == b.rotation &&
+                    a.half_extents == b.half_extents && a.measure == b.measure && a.first_child == b.first_child &&
+                    a.child_count == b.child_count && a.primitive == b.primitive && a.leaf_begin == b.leaf_begin &&
+                    a.leaf_count == b.leaf_count && a.type == b.type && a.axis_aligned == b.axis_aligned)
+            << "node " << i;
+        ASSERT_TRUE(test_support::same_volume(direct->volume(i), converted.volume(i))) << "node " << i;
+    }
+    EXPECT_TRUE(std::ranges::equal(direct->leaves(), converted.leaves()));
+    EXPECT_TRUE(std::ranges::equal(direct->primitive_nodes(), converted.primitive_nodes()));
+    EXPECT_EQ(direct->stack_bound(), converted.stack_bound());
+    EXPECT_EQ(direct->coordinate_bound(), converted.coordinate_bound());
+    EXPECT_EQ(direct->extent_bound(), converted.extent_bound());
+}
+
+/// read_binary, with QueryTree::read_binary checked against it on the same bytes.
+Result<Bvh> read(const std::string& bytes) {
+    Result<Bvh> bvh = read_binary(as_span(bytes), "test.hbvh");
+    expect_query_tree_agrees(bytes, bvh);
+    return bvh;
+}
 
 std::uint64_t load_u64(const std::string& bytes, std::size_t at) {
     std::uint64_t value = 0;
@@ -451,6 +493,14 @@ TEST(BinaryFormat, LargeFilesLoadTheSameAndReportTheFirstProblemInFileOrder) {
     back = read_binary_file(file);
     ASSERT_TRUE(back.has_value()) << back.error().to_string();
     expect_same(original, back.value());
+    // Straight into the query layout from the (mapped) file: the tree read_binary's Bvh converts to.
+    const Result<QueryTree> loaded = QueryTree::read_binary_file(file);
+    ASSERT_TRUE(loaded.has_value()) << loaded.error().to_string();
+    ASSERT_EQ(loaded->nodes().size(), original.nodes.size());
+    EXPECT_TRUE(std::ranges::equal(loaded->leaves(), QueryTree(original).leaves()));
+    const Result<QueryTree> missing = QueryTree::read_binary_file(dir / "missing.hbvh");
+    ASSERT_FALSE(missing.has_value());
+    EXPECT_EQ(missing.error().file, (dir / "missing.hbvh").string());
 
     // Where the records are, by the layout: the last node's record, the primitives' first and last.
     std::size_t last_node_at = 40;
