@@ -155,20 +155,25 @@ QueryTree::QueryTree(const Bvh& bvh, Checked) {
 }
 
 Result<QueryTree> QueryTree::read_binary(std::span<const std::byte> bytes, std::string_view source_name) {
-    // Each node goes into the query layout as it is decoded; the structure's checks run alongside and decide
-    // at the end (add_volume_and_links is safe on any node meanwhile). One task fills every array: two passes
-    // over the records, each filling half, were no faster on the 2-core machine of docs/formats.md.
-    class IntoQueryTree final : public detail::BinaryNodeSink {
+    // Each node goes into the query layout as it is decoded, by two passes over the node records that fill
+    // different arrays (as the conversion from a Bvh does); the structure's checks run alongside and decide at
+    // the end (add_volume_and_links is safe on any node meanwhile).
+    class StandIns final : public detail::BinaryNodeSink {
     public:
-        explicit IntoQueryTree(QueryTree& tree) : tree_(tree) {}
+        explicit StandIns(QueryTree& tree) : tree_(tree) {}
+        void reserve(std::uint64_t node_count, std::uint64_t /*primitive_count*/) override { tree_.reserve_stand_ins(node_count); }
+        void add(const Node& node) override { tree_.add_stand_ins(node); }
+
+    private:
+        QueryTree& tree_;
+    };
+    class VolumesAndLinks final : public detail::BinaryNodeSink {
+    public:
+        explicit VolumesAndLinks(QueryTree& tree) : tree_(tree) {}
         void reserve(std::uint64_t node_count, std::uint64_t primitive_count) override {
-            tree_.reserve_stand_ins(node_count);
             tree_.reserve_volumes_and_links(node_count, primitive_count, links_);
         }
-        void add(const Node& node) override {
-            tree_.add_stand_ins(node);
-            tree_.add_volume_and_links(next_++, node, links_);
-        }
+        void add(const Node& node) override { tree_.add_volume_and_links(next_++, node, links_); }
 
     private:
         QueryTree& tree_;
@@ -177,8 +182,10 @@ Result<QueryTree> QueryTree::read_binary(std::span<const std::byte> bytes, std::
     };
     const std::string file(source_name);
     QueryTree tree;
-    IntoQueryTree sink(tree);
-    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sink, nullptr);
+    StandIns stand_ins(tree);
+    VolumesAndLinks volumes_and_links(tree);
+    detail::BinaryNodeSink* const sinks[] = {&stand_ins, &volumes_and_links};
+    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sinks, nullptr);
     if (!decoded) return decoded.error();
     if (!decoded->sound) {
         // Something may be wrong: the Bvh reader's full checks decide, and name the problem as it does.

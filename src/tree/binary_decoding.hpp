@@ -37,10 +37,12 @@ struct DecodedBinary {
 };
 
 /// read_binary's decoding: the header, the checksum, the counts and every record, bounds-checked, with the
-/// nodes handed to `nodes` and the primitives appended to `primitives` (or, when it is null, checked and
-/// dropped). The Error is the one read_binary reports for the same bytes.
+/// nodes handed to each of `node_sinks` (one decoding pass each, so that sinks filling different arrays work
+/// at once) and the primitives appended to `primitives` (or, when it is null, checked and dropped). The Error
+/// is the one read_binary reports for the same bytes.
 [[nodiscard]] Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std::string& file,
-                                                  BinaryNodeSink& nodes, std::vector<Primitive>* primitives);
+                                                  std::span<BinaryNodeSink* const> node_sinks,
+                                                  std::vector<Primitive>* primitives);
 
 /// The bytes of the file at `path` handed to `use` while they are valid: a large regular file mapped, anything
 /// else read to its end into one buffer on huge pages. Failing to open or read gives an Error naming the file.

@@ -25,7 +25,7 @@
 #include <immintrin.h>
 #endif
 
-#include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -569,8 +569,8 @@ constexpr std::uint64_t mapped_read_bytes = std::uint64_t{1} << 20;
 
 namespace detail {
 
-Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std::string& file, BinaryNodeSink& nodes,
-                                   std::vector<Primitive>* primitives) {
+Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std::string& file,
+                                   std::span<BinaryNodeSink* const> node_sinks, std::vector<Primitive>* primitives) {
     auto fail = [&](std::size_t offset, const std::string& problem) -> Result<DecodedBinary> {
         return Error{"offset " + std::to_string(offset) + ": " + problem, file};
     };
@@ -638,13 +638,14 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     // primitive set, validate_primitives()) would check is tested on the fly without composing messages;
     // `sound` stays true only if all of it passed, and then stage 4 has nothing left to find.
     //
-    // In a large file the checksum, the nodes and the primitives are three tasks, run at once on the cores
-    // there are (filling the 300 MB of a 10^6-primitive tree is most of a load, and one core alone leaves half
-    // the machine idle). Each output is written by one task only, front to back, so the result does not depend
-    // on the thread count, and the problem reported is the one a reader going front to back finds first: a
-    // checksum mismatch, then the counts, then the first bad node record, then the first bad primitive record.
-    // Before the checksum is known the counts are only known to be possible for the file's size, which bounds
-    // what is allocated.
+    // In a large file the checksum, each sink's pass over the nodes and the primitives are tasks of their own,
+    // run at once on the cores there are (filling the 300 MB of a 10^6-primitive tree is most of a load, and one
+    // core alone leaves half the machine idle). Each output is written by one task only, front to back, so the
+    // result does not depend on the thread count, and the problem reported is the one a reader going front to
+    // back finds first: a checksum mismatch, then the counts, then the first bad node record, then the first
+    // bad primitive record (every pass over the nodes reads the same bytes; the first one's findings are
+    // kept). Before the checksum is known the counts are only known to be possible for the file's size, which
+    // bounds what is allocated.
     constexpr std::size_t concurrent_decode_bytes = std::size_t{1} << 19;  // below, a second task costs more than it saves
     const bool concurrent = size >= concurrent_decode_bytes && count_problem.empty();
     std::string corrupted;
@@ -652,20 +653,27 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
         if (corrupted = checksum_problem(); !corrupted.empty()) return fail(checksum_at, corrupted);
         if (!count_problem.empty()) return fail(count_problem_at, count_problem);
     }
-    DecodeOutcome nodes_outcome, primitives_outcome;
-    auto decode_nodes = [&] {
-        nodes.reserve(node_count, primitive_count);
-        nodes_outcome = decode_node_records(data, checksum_at, node_count, primitive_count, nodes);
+    std::vector<DecodeOutcome> node_outcomes(node_sinks.size());
+    DecodeOutcome primitives_outcome;
+    auto decode_nodes = [&](std::size_t pass) {
+        node_sinks[pass]->reserve(node_count, primitive_count);
+        node_outcomes[pass] = decode_node_records(data, checksum_at, node_count, primitive_count, *node_sinks[pass]);
     };
     auto decode_primitives = [&] {
         if (primitives != nullptr) detail::reserve_on_huge_pages(*primitives, primitive_count);
         primitives_outcome = decode_primitive_records(data, checksum_at, node_count, primitive_count, primitives);
     };
-    if (concurrent) tbb::parallel_invoke([&] { corrupted = checksum_problem(); }, decode_nodes, decode_primitives);
-    else {
-        decode_nodes();
-        if (nodes_outcome.problem.empty()) decode_primitives();
+    if (concurrent) {
+        tbb::task_group tasks;
+        for (std::size_t pass = 0; pass < node_sinks.size(); ++pass) tasks.run([&, pass] { decode_nodes(pass); });
+        tasks.run(decode_primitives);
+        corrupted = checksum_problem();
+        tasks.wait();
+    } else {
+        for (std::size_t pass = 0; pass < node_sinks.size(); ++pass) decode_nodes(pass);
+        if (node_outcomes.empty() || node_outcomes.front().problem.empty()) decode_primitives();
     }
+    const DecodeOutcome nodes_outcome = node_outcomes.empty() ? DecodeOutcome{} : node_outcomes.front();
     if (!corrupted.empty()) return fail(checksum_at, corrupted);
     if (!nodes_outcome.problem.empty()) return fail(nodes_outcome.problem_at, nodes_outcome.problem);
     if (!primitives_outcome.problem.empty()) return fail(primitives_outcome.problem_at, primitives_outcome.problem);
@@ -763,7 +771,8 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
     };
     Bvh bvh;
     IntoBvh sink(bvh.nodes);
-    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sink, &bvh.primitives);
+    detail::BinaryNodeSink* const sinks[] = {&sink};
+    const Result<detail::DecodedBinary> decoded = detail::decode_binary(bytes, file, sinks, &bvh.primitives);
     if (!decoded) return decoded.error();
     if (decoded->sound) return bvh;
 
