@@ -276,6 +276,7 @@ void write_xml_set(benchmark::State& state) {
 
 BENCHMARK_CAPTURE(load_xml, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK_CAPTURE(load_binary, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(20);
+BENCHMARK_CAPTURE(load_query_tree, 20k, 20'000u)->Unit(benchmark::kMillisecond)->Iterations(20)->UseManualTime();
 BENCHMARK_CAPTURE(load_xml, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(2);
 BENCHMARK_CAPTURE(load_binary, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5);
 BENCHMARK_CAPTURE(load_query_tree, 1M, 1'000'000u)->Unit(benchmark::kMillisecond)->Iterations(5)->UseManualTime();

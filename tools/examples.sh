@@ -68,10 +68,12 @@ print(f"examples: collide_model: {hit} {pairs} {cost} matches the CLI")
 EOF
 
 # core_only: its header comment works the answer out by hand: every primitive touches its own shifted copy only.
+# The tree it stores and loads back into the query layout must answer the same.
 expected="shifted 6 0-0 1-1 2-2 3-3 4-4 5-5
-apart 0"
+apart 0
+loaded 6 0-0 1-1 2-2 3-3 4-4 5-5"
 got="$("$work/core_only/core_only")" || fail "core_only failed"
-[ "$(head -n 2 <<<"$got")" = "$expected" ] || fail "core_only printed
+[ "$(head -n 3 <<<"$got")" = "$expected" ] || fail "core_only printed
 $got
 expected
 $expected"

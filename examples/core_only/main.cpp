@@ -1,10 +1,16 @@
 // SPDX-License-Identifier: MIT
-// hbvh::core alone: a hierarchy over primitives made in code, collided with a moved copy of itself.
+// hbvh::core alone: a hierarchy over primitives made in code, collided with a moved copy of itself; then stored
+// as .hbvh and loaded straight into the query layout, as a program that ships prebuilt trees does at start-up.
 #include <cstdio>
+#include <filesystem>
+#include <string>
 #include <vector>
+
+#include <unistd.h>
 
 #include <hbvh/builders/build.hpp>
 #include <hbvh/query/tandem_traversal.hpp>
+#include <hbvh/tree/binary_format.hpp>
 #include <hbvh/tree/stats.hpp>
 #include <hbvh/tree/validate.hpp>
 
@@ -48,5 +54,19 @@ int main() {
     const auto apart = hbvh::RigidTransform::from_quaternion(1.0, 0.0, 0.0, 0.0, hbvh::Vec3(0.0, 0.0, 5.0));
     print_pairs("shifted", hbvh::collide(tree, hbvh::RigidTransform::identity(), tree, shifted));
     print_pairs("apart", hbvh::collide(tree, hbvh::RigidTransform::identity(), tree, apart));
+
+    const std::filesystem::path stored =
+        std::filesystem::temp_directory_path() / ("hbvh_core_only_" + std::to_string(::getpid()) + ".hbvh");
+    if (const auto written = hbvh::write_binary_file(stored, *bvh); !written) {
+        std::fprintf(stderr, "%s\n", written.error().to_string().c_str());
+        return 1;
+    }
+    auto loaded = hbvh::QueryTree::read_binary_file(stored);
+    std::filesystem::remove(stored);
+    if (!loaded) {
+        std::fprintf(stderr, "%s\n", loaded.error().to_string().c_str());
+        return 1;
+    }
+    print_pairs("loaded", hbvh::collide(*loaded, hbvh::RigidTransform::identity(), *loaded, shifted));
     std::printf("nodes %zu cost %.6g\n", bvh->nodes.size(), hbvh::cost(*bvh));
 }
