@@ -7,10 +7,13 @@
 // the spheres, and they still enclose every sphere exactly.
 #include <Eigen/Eigenvalues>
 #include <algorithm>
+#include <cmath>
 #include <limits>
+#include <numbers>
 #include <optional>
 
 #include "frames.hpp"
+#include "rounding_pad.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/fit/fit.hpp"
@@ -71,7 +74,17 @@ BoundingVolume fit_fast(std::span<const Sphere> spheres, std::span<const Boundin
             best_cost = c;
         }
     };
-    if (policy.is_allowed(BvType::aabb)) consider(fit_aabb(spheres));
+    // With volume as the measure, a candidate that cannot beat the best so far is not finished (the result is
+    // the same: only losers are skipped). `within` is the largest unweighted volume a kind could still win with,
+    // a hair above the exact figure so that rounding in a bound never skips a winner.
+    const bool prune = policy.measure == NodeMeasure::volume;
+    const auto within = [&](BvType type) {
+        const double weight = policy.weight_of(type);
+        return best && prune && weight > 0.0 ? best_cost / weight * (1.0 + 1e-9)
+                                             : std::numeric_limits<double>::infinity();
+    };
+    const Aabb world_box = fit_aabb(spheres);
+    if (policy.is_allowed(BvType::aabb)) consider(world_box);
 
     const bool want_obb = policy.is_allowed(BvType::obb);
     const bool want_capsule = policy.is_allowed(BvType::capsule);
@@ -89,12 +102,27 @@ BoundingVolume fit_fast(std::span<const Sphere> spheres, std::span<const Boundin
         principal = detail::principal_frame(covariance);
     }
     if (want_obb) {
-        consider(detail::obb_with_axes(spheres, Mat3::Identity()));
-        consider(detail::obb_with_axes(spheres, principal));
+        // A box's volume is at least the product of its extents along its axes, which obb_with_axes_below
+        // measures before finishing it (finishing only grows it).
+        const auto consider_box = [&](const Mat3& rotation) {
+            if (std::optional<Obb> box = detail::obb_with_axes_below(spheres, rotation, within(BvType::obb)))
+                consider(std::move(*box));
+        };
+        consider_box(Mat3::Identity());
+        consider_box(principal);
         for (const BoundingVolume& hint : hints)
-            if (const Obb* box = std::get_if<Obb>(&hint)) consider(detail::obb_with_axes(spheres, box->rotation));
+            if (const Obb* box = std::get_if<Obb>(&hint)) consider_box(box->rotation);
     }
-    if (want_sphere) consider(mode == FastFitMode::exact_sphere ? fit_sphere(spheres) : quick_sphere(spheres, mean));
+    // Any sphere around the set is at least as wide as the set along each world axis (fit_aabb's rounding pads,
+    // about 4 ulps of the coordinates at each end, taken off twice over).
+    double widest = 0.0;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double magnitude = std::max(std::abs(world_box.min[axis]), std::abs(world_box.max[axis]));
+        widest = std::max(widest, world_box.max[axis] - world_box.min[axis] - 4.0 * detail::rounding_pad(magnitude));
+    }
+    const double smallest_sphere = 4.0 / 3.0 * std::numbers::pi * std::pow(0.5 * widest, 3);
+    if (want_sphere && smallest_sphere < within(BvType::sphere))
+        consider(mode == FastFitMode::exact_sphere ? fit_sphere(spheres) : quick_sphere(spheres, mean));
     if (want_capsule) {
         consider(capsule_on(spheres, mean, principal.col(0)));
         for (const BoundingVolume& hint : hints)
