@@ -17,14 +17,15 @@ namespace hbvh {
 struct FastOptions {
     /// Up to treelet_max_primitives primitives, the cheap tree is re-arranged by one bottom-up sweep of treelet
     /// refinement (docs/treelets.md) with this many units per treelet, every subset priced by fit_fast instead of
-    /// fit_best: microseconds a fit, 0.05-0.7 ms in all for 12-42 primitives. Below 3 units nothing is done.
-    std::uint32_t treelet_units = 4;
+    /// fit_best: microseconds a fit, 0.1-0.9 ms in all for 12-42 primitives. Below 3 units nothing is done.
+    std::uint32_t treelet_units = 5;
     /// Above this many primitives the sweep is skipped: its time grows faster than the rest of the preset's
     /// (1.8 ms at 54 primitives, 8 ms at 418: docs/fast.md), which is meant to stay near a millisecond.
     std::uint32_t treelet_max_primitives = 48;
     /// After the cheap build, this many inner nodes are refitted with fit_best over their primitives: those
     /// with the largest Eq. 2 terms (children x weighted volume), largest first. The root alone is most of
-    /// the gain on compact objects; each fit costs about 0.4-1 ms on a few dozen primitives (docs/fast.md).
+    /// the gain on compact objects; each fit costs about 0.1-0.3 ms on a few dozen primitives, and they run in
+    /// parallel (docs/fast.md).
     std::uint32_t exact_fits = 2;
     /// Nodes over more primitives than this are not refitted (fit_best is O(n log n) with a large constant:
     /// seconds at 10^6 primitives), so the preset stays fast at any size.
