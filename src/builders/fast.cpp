@@ -22,10 +22,14 @@ namespace {
 
 /// binned without its two slow steps for small inputs: the per-side fits of its cuts (estimate sweeps) and
 /// fit_best on every kept node. What is left is the box-priced cuts, the collapse and one cheap fit a node.
-BinnedOptions cheap_binned() {
+/// Where the treelet sweep follows, no node gets more children than a treelet has units: a wider node's
+/// children could never be re-grouped (on the duplo brick, an 8-child node kept the tree at 1.11x auto's cost;
+/// at most 5 children, 1.05x; no other object of docs/fast.md changed).
+BinnedOptions cheap_binned(std::uint32_t max_children) {
     BinnedOptions options;
     options.estimate_sweep_up_to = 0;
     options.exact_fit_all_up_to = 0;
+    options.max_children = max_children;
     return options;
 }
 
@@ -72,12 +76,15 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     // binned reports its progress as the first half, the refits the second.
     BuildContext first_step = context;
     if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };
-    Result<Bvh> built = build_binned(primitives, first_step, cheap_binned());
+    const bool sweep = options.treelet_units >= 3 && primitives.size() <= options.treelet_max_primitives;
+    Result<Bvh> built =
+        build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
+                                                                : BinnedOptions{}.max_children));
     if (!built || context.expired()) return built;
     // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is
     // most of the gap to auto (docs/fast.md). Treelets priced by the cheap fitter close much of it for a few
     // hundred microseconds, where fit_best's pricing (auto's) would cost a hundred times more.
-    if (options.treelet_units >= 3 && primitives.size() <= options.treelet_max_primitives) {
+    if (sweep) {
         detail::TreeletFitCache quick_fits(built->primitives.size(), detail::TreeletFitter::quick);
         TreeletOptions treelets;
         treelets.max_units = options.treelet_units;
