@@ -303,73 +303,17 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
     return out;
 }
 
-// Stage 3: files, as the CLI reads them (apps/hbvh/commands/common.cpp, read_model and load_model).
-
-/// The CLI's wording for a volume that misses a primitive (describe_violation).
-std::string describe(const Bvh& bvh, const ContainmentViolation& v) {
-    const std::string& name = bvh.primitives[v.primitive].name;
-    char by[32];
-    std::snprintf(by, sizeof by, "%.3g", v.protrusion);
-    return "volume (" + std::string(to_string(type_of(bvh.nodes[v.node].volume))) + ") does not enclose primitive " +
-           std::to_string(v.primitive) + (name.empty() ? std::string{} : " ('" + name + "')") + " by " + by;
-}
+// Stage 3: files, as the CLI reads them (read_model_file; then the CLI's load_model checks).
 
 int line_of(const Hierarchy& h, std::uint32_t node) { return node < h.node_lines.size() ? h.node_lines[node] : 0; }
 
 /// Primitives or a Hierarchy from any file the CLI reads. `format` as the CLI's --format.
 py::object load(const std::string& path, const std::string& format, bool refit) {
-    std::error_code ignored;
-    if (std::filesystem::is_directory(path, ignored)) raise(Error{"is a directory, not a file", path});
-    std::optional<Bvh> hierarchy;
-    std::vector<int> node_lines;
-    Primitives primitives;
-    const bool automatic = format.empty();
-    static const std::string_view known[] = {"", "xml", "mjcf", "urdf", "mesh", "mesh-nodes"};
-    if (std::find(std::begin(known), std::end(known), format) == std::end(known))
-        raise(Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)", path});
-    bool read = false;
-    if (format == "mesh-nodes") {
-        MeshImportOptions options;
-        options.one_primitive_per_mesh = true;
-        Result<ImportResult> imported = import_mesh(path, options);
-        if (!imported) raise(imported.error());
-        primitives = {std::move(imported->primitives), std::move(imported->warnings)};
-        read = true;
-    } else if (format == "xml" || (automatic && (lower_case_extension(path) == ".hbvh" || lower_case_extension(path) == ".xml"))) {
-        Result<std::string> text = read_text_file(path);
-        if (!text) raise(text.error());
-        const auto bytes = std::as_bytes(std::span(text.value()));
-        if ((automatic && lower_case_extension(path) == ".hbvh") || has_binary_magic(bytes)) {
-            Result<Bvh> bvh = read_binary(bytes, path);
-            if (!bvh) raise(bvh.error());
-            primitives.items = bvh->primitives;
-            if (!bvh->nodes.empty()) hierarchy = std::move(bvh.value());
-            read = true;
-        } else if (format == "xml" || text->find("<mujoco") == std::string::npos) {
-            Result<XmlModel> xml = read_xml_string(text.value(), path);
-            if (!xml) raise(xml.error());
-            primitives.items = std::move(xml->primitives);
-            hierarchy = std::move(xml->hierarchy);
-            node_lines = std::move(xml->node_lines);
-            read = true;
-        }
-    }
-    if (!read) {
-        static const std::pair<const char*, ImportFormat> formats[] = {
-            {"", ImportFormat::automatic}, {"mjcf", ImportFormat::mjcf}, {"urdf", ImportFormat::urdf},
-            {"mesh", ImportFormat::mesh}};
-        ImportFormat chosen = ImportFormat::automatic;
-        for (const auto& [name, value] : formats)
-            if (format == name) chosen = value;
-        Result<ImportResult> imported = import_primitives(path, chosen);
-        if (!imported) raise(imported.error());
-        if (imported->primitives.empty()) {
-            std::string message = "the file holds no collision primitives";
-            if (!imported->warnings.empty()) message += ": " + imported->warnings.front();
-            raise(Error{message, path});
-        }
-        primitives = {std::move(imported->primitives), std::move(imported->warnings)};
-    }
+    Result<ModelFile> read = read_model_file(path, format);
+    if (!read) raise(read.error());
+    Primitives primitives{std::move(read->primitives), std::move(read->warnings)};
+    std::optional<Bvh> hierarchy = std::move(read->hierarchy);
+    std::vector<int> node_lines = std::move(read->node_lines);
     // The checks of load_model, then the containment check every CLI command but stats makes.
     if (Status valid = validate_primitives(primitives.items); !valid) raise(Error{valid.error().message, path});
     if (Status finite = check_finite_extent(primitives.items); !finite) raise(Error{finite.error().message, path});
@@ -379,7 +323,7 @@ py::object load(const std::string& path, const std::string& format, bool refit) 
     const std::vector<ContainmentViolation> violations = containment_violations(result.bvh);
     if (!violations.empty()) {
         if (!refit) {
-            std::string message = describe(result.bvh, violations.front());
+            std::string message = describe_violation(result.bvh, violations.front());
             if (violations.size() > 1) message += " (and " + std::to_string(violations.size() - 1) + " more volumes)";
             raise(Error{message + "; load(..., refit=True) refits them", path, line_of(result, violations.front().node)});
         }
@@ -434,7 +378,7 @@ py::dict stats_dict(const Hierarchy& h) {
         violations.append(py::dict("node"_a = v.node, "line"_a = line_of(h, v.node),
                                    "type"_a = std::string(to_string(type_of(h.bvh.nodes[v.node].volume))),
                                    "primitive"_a = v.primitive, "name"_a = h.bvh.primitives[v.primitive].name,
-                                   "by"_a = v.protrusion, "message"_a = describe(h.bvh, v)));
+                                   "by"_a = v.protrusion, "message"_a = describe_violation(h.bvh, v)));
     py::dict out;
     out["cost"] = stats.cost, out["calibrated_cost"] = stats.calibrated_cost, out["height"] = stats.height, out["nodes"] = stats.nodes;
     out["inner_nodes"] = stats.inner_nodes, out["leaves"] = stats.leaves;

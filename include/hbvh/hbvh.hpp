@@ -63,6 +63,7 @@
 #include <hbvh/io/file.hpp>
 #include <hbvh/io/xml.hpp>
 #include <hbvh/io/import.hpp>
+#include <hbvh/io/model_file.hpp>
 #include <hbvh/io/mjcf.hpp>
 #include <hbvh/io/urdf.hpp>
 #include <hbvh/io/mesh_import.hpp>

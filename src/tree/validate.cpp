@@ -107,6 +107,15 @@ std::vector<ContainmentViolation> containment_violations(const Bvh& bvh, double 
     return violations;
 }
 
+std::string describe_violation(const Bvh& bvh, const ContainmentViolation& violation) {
+    const std::string& name = bvh.primitives[violation.primitive].name;
+    char by[32];
+    std::snprintf(by, sizeof by, "%.3g", violation.protrusion);
+    return "volume (" + std::string(to_string(type_of(bvh.nodes[violation.node].volume))) +
+           ") does not enclose primitive " + std::to_string(violation.primitive) +
+           (name.empty() ? std::string{} : " ('" + name + "')") + " by " + by;
+}
+
 Status validate(const Bvh& bvh, double relative_tolerance) {
     if (Status structure = check_structure(bvh); !structure) return structure;
     const std::vector<ContainmentViolation> violations = containment_violations(bvh, relative_tolerance);

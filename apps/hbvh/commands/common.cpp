@@ -11,85 +11,27 @@
 #include "commands/command.hpp"
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/file.hpp"
-#include "hbvh/io/import.hpp"
-#include "hbvh/io/mesh_import.hpp"
-#include "hbvh/io/xml.hpp"
-#include "hbvh/tree/binary_format.hpp"
+#include "hbvh/io/model_file.hpp"
 #include "hbvh/tree/refit.hpp"
 
 namespace hbvh::cli {
 
 namespace {
-/// A binary file's contents as a Model: a primitive set (node count 0) has no hierarchy, and then its
-/// primitives move instead of being copied (at 10^6 primitives, 160 MB).
-Result<Model> model_of(Result<Bvh> bvh) {
-    if (!bvh) return bvh.error();
-    if (bvh->nodes.empty()) return Model{std::move(bvh->primitives), std::nullopt, {}, {}, {}};
-    std::vector<Primitive> primitives = bvh->primitives;
-    return Model{std::move(primitives), std::move(bvh.value()), {}, {}, {}};
+/// Standard input, as survey XML or .hbvh bytes (other formats need a file name: the importers read files).
+Result<ModelFile> read_standard_input(const std::string& format) {
+    if (!format.empty() && format != "xml")
+        return Error{"standard input is read as survey XML or .hbvh; --format " + format + " needs a file", "<stdin>"};
+    const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+    return read_model_bytes(text, "<stdin>");
 }
 
-/// The file as a Model, without checks across primitives (load_model adds those).
+/// The file as a Model, without checks across primitives (load_model adds those): read as the Python module
+/// reads it (read_model_file).
 Result<Model> read_model(const std::string& path, const std::string& format) {
-    // Before any guess from the extension: a directory named "scene.xml" or "tmp.x1y2" is still a directory.
-    std::error_code ignored;
-    if (path != "-" && std::filesystem::is_directory(path, ignored)) return Error{"is a directory, not a file", path};
-    // A plain mesh (no UBX_/USP_/UCP_/UCX_ pieces) is imported only on request: one fitted primitive per
-    // mesh node is a guess at the author's intent, not a reading of it.
-    if (format == "mesh-nodes") {
-        MeshImportOptions options;
-        options.one_primitive_per_mesh = true;
-        Result<ImportResult> imported = import_mesh(path, options);
-        if (!imported) return imported.error();
-        return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings), {}, {}};
-    }
-    // The survey format keeps a stored hierarchy; the importers give primitives only.
-    static const std::pair<const char*, ImportFormat> formats[] = {
-        {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
-        {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
-    const auto chosen = std::find_if(std::begin(formats), std::end(formats),
-                                     [&](const auto& entry) { return format == entry.first; });
-    if (chosen == std::end(formats))
-        return Error{"unknown input format '" + format + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)", path};
-
-    const std::string extension = std::filesystem::path(path).extension().string();
-    // A .hbvh name, or (stdin, .xml) the binary format's magic bytes: docs/formats.md, "The binary format".
-    const bool binary_name = chosen->second == ImportFormat::automatic && lower_case_extension(path) == ".hbvh";
-    const bool maybe_survey = binary_name || path == "-" || chosen->second == ImportFormat::survey_xml ||
-                              (chosen->second == ImportFormat::automatic && extension == ".xml");
-    // A named .hbvh file goes to the binary reader's own file path, which maps a large file instead of copying it.
-    if (binary_name && path != "-") return model_of(read_binary_file(path));
-    if (maybe_survey) {
-        std::string text;
-        if (path == "-") {
-            text.assign(std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>());
-        } else {
-            Result<std::string> file = read_text_file(path);
-            if (!file) return file.error();
-            text = std::move(file.value());
-        }
-        if (binary_name || has_binary_magic(std::as_bytes(std::span(text))))
-            return model_of(read_binary(std::as_bytes(std::span(text)), path == "-" ? "<stdin>" : path));
-        // An .xml whose root is <mujoco> is MJCF: hand it to the importer below.
-        if (path == "-" || chosen->second == ImportFormat::survey_xml || text.find("<mujoco") == std::string::npos) {
-            Result<XmlModel> xml = read_xml_string(text, path == "-" ? "<stdin>" : path);
-            if (!xml) return xml.error();
-            return Model{std::move(xml->primitives), std::move(xml->hierarchy), {}, {}, std::move(xml->node_lines)};
-        }
-    }
-    Result<ImportResult> imported = import_primitives(path, chosen->second);
-    if (!imported) return imported.error();
-    if (imported->primitives.empty()) {
-        // The importer's warnings say why each candidate was skipped (mesh geoms, unnamed meshes, ...); the
-        // error is all the user will see, so it carries them.
-        std::string message = "the file holds no collision primitives";
-        const std::vector<std::string>& skipped = imported->warnings;
-        constexpr std::size_t shown = 3;
-        for (std::size_t i = 0; i < std::min(skipped.size(), shown); ++i) message += (i == 0 ? ": " : "; ") + skipped[i];
-        if (skipped.size() > shown) message += "; and " + std::to_string(skipped.size() - shown) + " more";
-        return Error{message, path};
-    }
-    return Model{std::move(imported->primitives), std::nullopt, std::move(imported->warnings), {}, {}};
+    Result<ModelFile> read = path == "-" ? read_standard_input(format) : read_model_file(path, format);
+    if (!read) return read.error();
+    return Model{std::move(read->primitives), std::move(read->hierarchy), std::move(read->warnings), {},
+                 std::move(read->node_lines)};
 }
 }  // namespace
 
@@ -200,13 +142,6 @@ void BuilderFlags::add_refit_to(CLI::App& command) {
 
 int line_of_node(const Model& model, std::uint32_t node) {
     return node < model.node_lines.size() ? model.node_lines[node] : 0;
-}
-
-std::string describe_violation(const Bvh& bvh, const ContainmentViolation& violation) {
-    const std::string& name = bvh.primitives[violation.primitive].name;
-    return fmt::format("volume ({}) does not enclose primitive {}{} by {:.3g}",
-                       to_string(type_of(bvh.nodes[violation.node].volume)), violation.primitive,
-                       name.empty() ? std::string{} : " ('" + name + "')", violation.protrusion);
 }
 
 namespace {

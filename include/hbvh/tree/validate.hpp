@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "hbvh/result.hpp"
@@ -38,6 +39,10 @@ struct ContainmentViolation {
 /// its worst primitive, in node order. Precondition: check_structure(bvh) passed.
 [[nodiscard]] std::vector<ContainmentViolation> containment_violations(
     const Bvh& bvh, double relative_tolerance = default_containment_tolerance);
+
+/// A violation in words, as the CLI and the Python module report it: "volume (obb) does not enclose primitive 3
+/// ('leg') by 0.0125" (the name when it has one, the protrusion to three significant digits).
+[[nodiscard]] std::string describe_violation(const Bvh& bvh, const ContainmentViolation& violation);
 
 /// check_structure(), then containment: every node's BV holds every covered primitive (relative
 /// tolerance, see containment_tolerance). The Error names the first node that fails.

@@ -1,0 +1,39 @@
+// SPDX-License-Identifier: MIT
+// Any file hbvh reads, by one call: the survey XML, the .hbvh binary format, MJCF, URDF and meshes. The CLI and
+// the Python module read their inputs through it, so a file is read, and refused, the same way everywhere.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hbvh/geometry/primitive.hpp"
+#include "hbvh/result.hpp"
+#include "hbvh/tree/bvh.hpp"
+
+namespace hbvh {
+
+/// What a file holds: its primitives, the hierarchy stored in it (a nested survey XML or a .hbvh tree; none from
+/// the importers), the importers' notes about what they skipped, and each stored node's line in a survey XML.
+struct ModelFile {
+    std::vector<Primitive> primitives;
+    std::optional<Bvh> hierarchy;  ///< Its primitives are `primitives`, in the same order.
+    std::vector<std::string> warnings;
+    std::vector<int> node_lines;  ///< XmlModel::node_lines; empty for other formats.
+};
+
+/// Reads `path` as `format` says: "" decides by the name and the content (.hbvh, or bytes that start with
+/// binary_magic: the binary format; .xml: MJCF when its root is <mujoco>, else the survey format; .urdf; the mesh
+/// extensions of import_primitives), "xml" (survey XML or .hbvh bytes), "mjcf", "urdf", "mesh", or "mesh-nodes"
+/// (a plain mesh, one fitted primitive per mesh node). A large .hbvh file is mapped rather than copied. Errors
+/// name the file: a directory, an unknown format, the reader's or importer's own error, and a file that yields
+/// no primitive (with the first three candidates the importer skipped, and why). Nothing is checked across
+/// primitives or nodes: validate_primitives, check_structure and containment_violations are the caller's.
+[[nodiscard]] Result<ModelFile> read_model_file(const std::string& path, std::string_view format = {});
+
+/// Survey XML or .hbvh bytes already in memory (an asset taken from an archive, standard input), read as
+/// read_model_file reads such a file; `name` goes into errors.
+[[nodiscard]] Result<ModelFile> read_model_bytes(std::string_view bytes, const std::string& name);
+
+}  // namespace hbvh

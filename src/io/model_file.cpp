@@ -1,0 +1,104 @@
+// SPDX-License-Identifier: MIT
+// read_model_file: the one reader of every input format, shared by the CLI and the Python module.
+#include "hbvh/io/model_file.hpp"
+
+#include <algorithm>
+#include <filesystem>
+#include <iterator>
+#include <span>
+#include <system_error>
+#include <utility>
+
+#include "hbvh/io/file.hpp"
+#include "hbvh/io/import.hpp"
+#include "hbvh/io/mesh_import.hpp"
+#include "hbvh/io/xml.hpp"
+#include "hbvh/tree/binary_format.hpp"
+
+namespace hbvh {
+namespace {
+
+/// A .hbvh file's contents: a primitive set (node count 0) has no hierarchy, and then its primitives move
+/// instead of being copied (at 10^6 primitives, 160 MB).
+Result<ModelFile> from_binary(Result<Bvh> bvh) {
+    if (!bvh) return bvh.error();
+    ModelFile model;
+    if (bvh->nodes.empty()) {
+        model.primitives = std::move(bvh->primitives);
+    } else {
+        model.primitives = bvh->primitives;
+        model.hierarchy = std::move(bvh.value());
+    }
+    return model;
+}
+
+/// The importers' result; a file they found nothing in is an error that carries their reasons, since the error
+/// is all a user of the CLI will see.
+Result<ModelFile> from_import(Result<ImportResult> imported, const std::string& path) {
+    if (!imported) return imported.error();
+    if (imported->primitives.empty()) {
+        std::string message = "the file holds no collision primitives";
+        const std::vector<std::string>& skipped = imported->warnings;
+        constexpr std::size_t shown = 3;
+        for (std::size_t i = 0; i < std::min(skipped.size(), shown); ++i) message += (i == 0 ? ": " : "; ") + skipped[i];
+        if (skipped.size() > shown) message += "; and " + std::to_string(skipped.size() - shown) + " more";
+        return Error{message, path};
+    }
+    ModelFile model;
+    model.primitives = std::move(imported->primitives);
+    model.warnings = std::move(imported->warnings);
+    return model;
+}
+
+}  // namespace
+
+Result<ModelFile> read_model_file(const std::string& path, std::string_view format) {
+    // Before any guess from the extension: a directory named "scene.xml" is still a directory.
+    std::error_code ignored;
+    if (std::filesystem::is_directory(path, ignored)) return Error{"is a directory, not a file", path};
+    // A plain mesh (no UBX_/USP_/UCP_/UCX_ pieces) is imported only on request: one fitted primitive per mesh
+    // node is a guess at the author's intent, not a reading of it.
+    if (format == "mesh-nodes") {
+        MeshImportOptions options;
+        options.one_primitive_per_mesh = true;
+        return from_import(import_mesh(path, options), path);
+    }
+    // The survey format keeps a stored hierarchy; the importers give primitives only.
+    static const std::pair<std::string_view, ImportFormat> formats[] = {
+        {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
+        {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
+    const auto chosen = std::find_if(std::begin(formats), std::end(formats),
+                                     [&](const auto& entry) { return format == entry.first; });
+    if (chosen == std::end(formats))
+        return Error{"unknown input format '" + std::string(format) + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)",
+                     path};
+
+    const bool automatic = chosen->second == ImportFormat::automatic;
+    const std::string extension = lower_case_extension(path);
+    // A .hbvh name goes to the binary reader's own file path, which maps a large file instead of copying it.
+    if (automatic && extension == ".hbvh") return from_binary(read_binary_file(path));
+    if (chosen->second == ImportFormat::survey_xml || (automatic && extension == ".xml")) {
+        Result<std::string> text = read_text_file(path);
+        if (!text) return text.error();
+        // An .xml whose root is <mujoco> is MJCF (the importer below takes it), unless the format says otherwise.
+        if (!automatic || has_binary_magic(std::as_bytes(std::span(text.value()))) ||
+            text->find("<mujoco") == std::string::npos)
+            return read_model_bytes(text.value(), path);
+    }
+    return from_import(import_primitives(path, chosen->second), path);
+}
+
+Result<ModelFile> read_model_bytes(std::string_view bytes, const std::string& name) {
+    // Binary bytes under any name: docs/formats.md, "The binary format".
+    const std::span<const std::byte> raw = std::as_bytes(std::span(bytes.data(), bytes.size()));
+    if (has_binary_magic(raw)) return from_binary(read_binary(raw, name));
+    Result<XmlModel> xml = read_xml_string(bytes, name);
+    if (!xml) return xml.error();
+    ModelFile model;
+    model.primitives = std::move(xml->primitives);
+    model.hierarchy = std::move(xml->hierarchy);
+    model.node_lines = std::move(xml->node_lines);
+    return model;
+}
+
+}  // namespace hbvh

@@ -1,0 +1,134 @@
+// SPDX-License-Identifier: MIT
+// read_model_file and read_model_bytes: every input format through one call, a stored hierarchy kept from survey
+// XML and .hbvh (whatever the name says, the bytes decide), MJCF under .xml, the importers' empty results refused
+// with their reasons, and the refusals the CLI and the Python module rely on.
+#include "hbvh/io/model_file.hpp"
+
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+
+#include "hbvh/io/file.hpp"
+#include "hbvh/io/xml.hpp"
+#include "hbvh/tree/binary_format.hpp"
+#include "io/import_test_support.hpp"
+#include "io/sample_hierarchy.hpp"
+
+namespace hbvh {
+namespace {
+
+namespace fs = std::filesystem;
+
+class ModelFileTest : public ::testing::Test {
+protected:
+    void SetUp() override {
+        folder_ = fs::temp_directory_path() / ("hbvh_model_file_" + std::to_string(::getpid()));
+        fs::create_directories(folder_);
+    }
+    void TearDown() override { fs::remove_all(folder_); }
+    std::string path(const std::string& name) const { return (folder_ / name).string(); }
+    void write(const std::string& name, const std::string& content) const {
+        std::ofstream(folder_ / name, std::ios::binary) << content;
+    }
+    fs::path folder_;
+};
+
+/// Same primitives (kinds, numbers within the XML's decimal rounding, names) and, with a hierarchy, same shape.
+void expect_same(const ModelFile& read, const Bvh& written) {
+    ASSERT_EQ(read.primitives.size(), written.primitives.size());
+    for (std::size_t i = 0; i < written.primitives.size(); ++i) {
+        EXPECT_EQ(test::compare_volumes(read.primitives[i].volume, written.primitives[i].volume, 1e-12), "") << i;
+        EXPECT_EQ(read.primitives[i].name, written.primitives[i].name) << i;
+    }
+    ASSERT_TRUE(read.hierarchy.has_value());
+    ASSERT_EQ(read.hierarchy->nodes.size(), written.nodes.size());
+    for (std::size_t i = 0; i < written.nodes.size(); ++i) {
+        EXPECT_EQ(read.hierarchy->nodes[i].child_count, written.nodes[i].child_count) << i;
+        EXPECT_EQ(read.hierarchy->nodes[i].first_child, written.nodes[i].first_child) << i;
+    }
+}
+
+TEST_F(ModelFileTest, StoredHierarchiesComeBackFromXmlAndBinaryWhateverTheName) {
+    const Bvh tree = test::sample_hierarchy();
+    write("tree.xml", write_xml(tree));
+    ASSERT_TRUE(write_binary_file(path("tree.hbvh"), tree));
+    const std::string binary = write_binary(tree);
+    write("binary_named.xml", binary);
+
+    // Survey XML lists a hierarchy's primitives in its leaves' order: what the XML reader itself gives.
+    const Result<ModelFile> xml = read_model_file(path("tree.xml"));
+    ASSERT_TRUE(xml.has_value()) << xml.error().to_string();
+    const Result<XmlModel> direct = read_xml_file(path("tree.xml"));
+    ASSERT_TRUE(direct.has_value() && direct->hierarchy.has_value());
+    expect_same(*xml, *direct->hierarchy);
+    EXPECT_EQ(xml->node_lines, direct->node_lines);
+    EXPECT_EQ(xml->node_lines.size(), tree.nodes.size());  // survey XML knows each node's line
+    for (const std::string name : {"tree.hbvh", "binary_named.xml"}) {
+        SCOPED_TRACE(name);
+        const Result<ModelFile> read = read_model_file(path(name));
+        ASSERT_TRUE(read.has_value()) << read.error().to_string();
+        expect_same(*read, tree);
+        EXPECT_TRUE(read->node_lines.empty());
+    }
+    // Bytes in memory, as from an archive or standard input.
+    const Result<ModelFile> from_bytes = read_model_bytes(binary, "asset");
+    ASSERT_TRUE(from_bytes.has_value()) << from_bytes.error().to_string();
+    expect_same(*from_bytes, tree);
+    const Result<ModelFile> from_text = read_model_bytes(write_xml(tree), "asset");
+    ASSERT_TRUE(from_text.has_value()) << from_text.error().to_string();
+    expect_same(*from_text, *direct->hierarchy);
+    // A primitive set has no hierarchy.
+    write("set.xml", write_primitives_xml(tree.primitives));
+    const Result<ModelFile> set = read_model_file(path("set.xml"));
+    ASSERT_TRUE(set.has_value()) << set.error().to_string();
+    EXPECT_EQ(set->primitives.size(), tree.primitives.size());
+    EXPECT_FALSE(set->hierarchy.has_value());
+    // Broken bytes are the binary reader's error, naming the source.
+    const Result<ModelFile> cut = read_model_bytes(binary.substr(0, binary.size() - 3), "asset");
+    ASSERT_FALSE(cut.has_value());
+    EXPECT_EQ(cut.error().file, "asset");
+    EXPECT_NE(cut.error().message.find("truncated"), std::string::npos) << cut.error().message;
+}
+
+TEST_F(ModelFileTest, ImportersByExtensionRootAndFormat) {
+    const fs::path data = test::test_data_dir();
+    const std::string mjcf = (data / "mjcf_defaults.xml").string();
+    const Result<ModelFile> by_root = read_model_file(mjcf);  // .xml with <mujoco>: MJCF
+    ASSERT_TRUE(by_root.has_value()) << by_root.error().to_string();
+    EXPECT_EQ(by_root->primitives.size(), 9u);
+    EXPECT_FALSE(by_root->hierarchy.has_value());
+    const Result<ModelFile> as_survey = read_model_file(mjcf, "xml");  // the format wins over the root
+    ASSERT_FALSE(as_survey.has_value());
+    EXPECT_EQ(as_survey.error().file, mjcf);
+    const Result<ModelFile> urdf = read_model_file((data / "urdf_chain.urdf").string());
+    ASSERT_TRUE(urdf.has_value()) << urdf.error().to_string();
+    EXPECT_EQ(urdf->primitives.size(), 4u);
+    const Result<ModelFile> forced = read_model_file(mjcf, "urdf");
+    ASSERT_FALSE(forced.has_value());
+    EXPECT_NE(forced.error().message.find("expected <robot>"), std::string::npos);
+}
+
+TEST_F(ModelFileTest, RefusesDirectoriesUnknownFormatsAndFilesWithoutPrimitives) {
+    fs::create_directories(folder_ / "scene.xml");
+    const Result<ModelFile> directory = read_model_file(path("scene.xml"));
+    ASSERT_FALSE(directory.has_value());
+    EXPECT_EQ(directory.error().message, "is a directory, not a file");
+    write("a.xml", "<hierarchy/>");
+    const Result<ModelFile> unknown = read_model_file(path("a.xml"), "step");
+    ASSERT_FALSE(unknown.has_value());
+    EXPECT_NE(unknown.error().message.find("unknown input format 'step'"), std::string::npos);
+    // Four skipped geoms: the message names the first three and counts the rest.
+    write("meshes.xml", "<mujoco><worldbody><geom name='a' type='mesh' mesh='m'/><geom name='b' type='mesh' mesh='m'/>"
+                        "<geom name='c' type='mesh' mesh='m'/><geom name='d' type='mesh' mesh='m'/></worldbody></mujoco>");
+    const Result<ModelFile> empty = read_model_file(path("meshes.xml"));
+    ASSERT_FALSE(empty.has_value());
+    EXPECT_EQ(empty.error().message.rfind("the file holds no collision primitives: ", 0), 0u) << empty.error().message;
+    EXPECT_NE(empty.error().message.find("; and 1 more"), std::string::npos) << empty.error().message;
+}
+
+}  // namespace
+}  // namespace hbvh
