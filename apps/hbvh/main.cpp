@@ -4,12 +4,13 @@
 #include <cstdio>
 
 #include "commands/command.hpp"
+#include "hbvh/version.hpp"
 
 int main(int argc, char** argv) {
     using namespace hbvh::cli;
     CLI::App app{"hbvh: builds heterogeneous bounding-volume hierarchies (AABB, OBB, sphere, capsule) over\n"
                  "primitive volumes, measures them, and answers collision queries with them."};
-    app.set_version_flag("--version", std::string("hbvh ") + HBVH_VERSION);
+    app.set_version_flag("--version", std::string("hbvh ") + HBVH_VERSION_STRING);
     app.require_subcommand(1);
     Command command;
     add_algorithms_command(app, command);

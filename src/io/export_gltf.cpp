@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "hbvh/io/level_view.hpp"
+#include "hbvh/version.hpp"
 
 namespace hbvh {
 namespace {
@@ -88,7 +89,7 @@ struct MeshAccessors {
 
 std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
     json gltf;
-    gltf["asset"] = {{"version", "2.0"}, {"generator", std::string("hbvh ") + HBVH_VERSION}};
+    gltf["asset"] = {{"version", "2.0"}, {"generator", std::string("hbvh ") + HBVH_VERSION_STRING}};
     gltf["scene"] = 0;
     json scene = {{"name", "hbvh levels"}};
     if (bvh.empty()) {
