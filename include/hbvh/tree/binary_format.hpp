@@ -45,8 +45,10 @@ inline constexpr std::uint32_t binary_format_version = 1;
 /// comes back as a Bvh with no nodes. Containment is not checked: run validate() for that, as for XML.
 [[nodiscard]] Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view source_name);
 
-/// Reads the file at `path` (one buffer sized from the file, in huge pages where Linux offers them; pipes and
-/// growing files are read to their end) and parses it with read_binary; errors name the file as given.
+/// Reads the file at `path` (a regular file of 1 MiB or more mapped; anything else read into one buffer sized from
+/// the file, in huge pages where Linux offers them, pipes and growing files to their end) and parses it with
+/// read_binary; errors name the file as given. To query the tree, QueryTree::read_binary_file loads it straight
+/// into the query layout instead.
 [[nodiscard]] Result<Bvh> read_binary_file(const std::filesystem::path& path);
 
 /// Writes write_binary(bvh) to `path` atomically: a new temporary file in the same directory, fsync, then
