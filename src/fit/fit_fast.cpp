@@ -113,16 +113,18 @@ BoundingVolume fit_fast(std::span<const Sphere> spheres, std::span<const Boundin
         for (const BoundingVolume& hint : hints)
             if (const Obb* box = std::get_if<Obb>(&hint)) consider_box(box->rotation);
     }
-    // Any sphere around the set is at least as wide as the set along each world axis (fit_aabb's rounding pads,
-    // about 4 ulps of the coordinates at each end, taken off twice over).
-    double widest = 0.0;
-    for (int axis = 0; axis < 3; ++axis) {
-        const double magnitude = std::max(std::abs(world_box.min[axis]), std::abs(world_box.max[axis]));
-        widest = std::max(widest, world_box.max[axis] - world_box.min[axis] - 4.0 * detail::rounding_pad(magnitude));
+    if (want_sphere) {
+        // Any sphere around the set is at least as wide as the set along each world axis (fit_aabb's rounding
+        // pads, about 4 ulps of the coordinates at each end, taken off twice over).
+        double widest = 0.0;
+        for (int axis = 0; axis < 3; ++axis) {
+            const double magnitude = std::max(std::abs(world_box.min[axis]), std::abs(world_box.max[axis]));
+            widest = std::max(widest, world_box.max[axis] - world_box.min[axis] - 4.0 * detail::rounding_pad(magnitude));
+        }
+        const double smallest_sphere = 4.0 / 3.0 * std::numbers::pi * std::pow(0.5 * widest, 3);
+        if (smallest_sphere < within(BvType::sphere))
+            consider(mode == FastFitMode::exact_sphere ? fit_sphere(spheres) : quick_sphere(spheres, mean));
     }
-    const double smallest_sphere = 4.0 / 3.0 * std::numbers::pi * std::pow(0.5 * widest, 3);
-    if (want_sphere && smallest_sphere < within(BvType::sphere))
-        consider(mode == FastFitMode::exact_sphere ? fit_sphere(spheres) : quick_sphere(spheres, mean));
     if (want_capsule) {
         consider(capsule_on(spheres, mean, principal.col(0)));
         for (const BoundingVolume& hint : hints)

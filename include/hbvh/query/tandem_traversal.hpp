@@ -84,8 +84,8 @@ public:
     /// As the constructor, returning the Error instead of throwing.
     [[nodiscard]] static Result<QueryTree> create(const Bvh& bvh);
     /// Reads a .hbvh hierarchy straight into the query layout, with no Bvh in between: for a program that
-    /// loads trees at start-up only to query them (at 10^6 primitives half the memory and about a third of the
-    /// time of hbvh::read_binary followed by create; docs/formats.md, "Load time"). Refuses what read_binary
+    /// loads trees at start-up only to query them (at 10^6 primitives about half the memory and half the time
+    /// of hbvh::read_binary followed by create; docs/formats.md, "Load time"). Refuses what read_binary
     /// refuses, with the same Error, and a file that holds a primitive set rather than a hierarchy.
     [[nodiscard]] static Result<QueryTree> read_binary(std::span<const std::byte> bytes, std::string_view source_name);
     /// As above, from the file at `path` (mapped when it is large); errors name the file as given.
@@ -115,7 +115,7 @@ private:
     QueryTree(const Bvh& bvh, Checked);
     QueryTree() = default;
 
-    /// Where the breadth-first links of the nodes added so far lead (see add_links).
+    /// Where the breadth-first links of the nodes added so far lead (see add_volume_and_links).
     struct LinkState {
         std::vector<std::uint32_t> path_sum;  ///< Per node: sum of child counts from the root down to it.
         std::uint64_t next_child = 1;         ///< Where the next inner node's children must start.
