@@ -4,7 +4,10 @@
 // hide a broken method; Google Benchmark itself exits 0 after SkipWithError.
 #include <benchmark/benchmark.h>
 
+#include <cstdlib>
 #include <string>
+
+#include "hbvh/io/xml_memory.hpp"
 
 namespace hbvh::bench {
 namespace {
@@ -20,6 +23,9 @@ void fail(benchmark::State& state, const std::string& message) {
 }  // namespace hbvh::bench
 
 int main(int argc, char** argv) {
+    // As the CLI does (apps/hbvh/main.cpp), so that the XML rows time what `hbvh` pays. With
+    // HBVH_BENCH_XML_MALLOC set, pugixml keeps malloc: the rows then time a program that did not opt in.
+    if (std::getenv("HBVH_BENCH_XML_MALLOC") == nullptr) hbvh::use_huge_pages_for_xml();
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
     benchmark::RunSpecifiedBenchmarks();

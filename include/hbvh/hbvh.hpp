@@ -62,6 +62,7 @@
 #if __has_include(<hbvh/io/xml.hpp>)
 #include <hbvh/io/file.hpp>
 #include <hbvh/io/xml.hpp>
+#include <hbvh/io/xml_memory.hpp>
 #include <hbvh/io/import.hpp>
 #include <hbvh/io/model_file.hpp>
 #include <hbvh/io/mjcf.hpp>

@@ -14,6 +14,7 @@
 #include "hbvh/io/mesh_import.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/tree/binary_format.hpp"
+#include "xml_taking.hpp"
 
 namespace hbvh {
 namespace {
@@ -29,6 +30,16 @@ Result<ModelFile> from_binary(Result<Bvh> bvh) {
         model.primitives = bvh->primitives;
         model.hierarchy = std::move(bvh.value());
     }
+    return model;
+}
+
+/// A survey XML file's contents.
+Result<ModelFile> from_xml(Result<XmlModel> xml) {
+    if (!xml) return xml.error();
+    ModelFile model;
+    model.primitives = std::move(xml->primitives);
+    model.hierarchy = std::move(xml->hierarchy);
+    model.node_lines = std::move(xml->node_lines);
     return model;
 }
 
@@ -81,9 +92,11 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         Result<std::string> text = read_text_file(path);
         if (!text) return text.error();
         // An .xml whose root is <mujoco> is MJCF (the importer below takes it), unless the format says otherwise.
-        if (!automatic || has_binary_magic(std::as_bytes(std::span(text.value()))) ||
-            text->find("<mujoco") == std::string::npos)
-            return read_model_bytes(text.value(), path);
+        const std::span<const std::byte> raw = std::as_bytes(std::span(text.value()));
+        if (has_binary_magic(raw)) return from_binary(read_binary(raw, path));
+        // The XML reader takes the text over: a 230 MB file is parsed where it was read, not copied.
+        if (!automatic || text->find("<mujoco") == std::string::npos)
+            return from_xml(detail::read_xml_taking(std::move(text).value(), path));
     }
     return from_import(import_primitives(path, chosen->second), path);
 }
@@ -92,13 +105,7 @@ Result<ModelFile> read_model_bytes(std::string_view bytes, const std::string& na
     // Binary bytes under any name: docs/formats.md, "The binary format".
     const std::span<const std::byte> raw = std::as_bytes(std::span(bytes.data(), bytes.size()));
     if (has_binary_magic(raw)) return from_binary(read_binary(raw, name));
-    Result<XmlModel> xml = read_xml_string(bytes, name);
-    if (!xml) return xml.error();
-    ModelFile model;
-    model.primitives = std::move(xml->primitives);
-    model.hierarchy = std::move(xml->hierarchy);
-    model.node_lines = std::move(xml->node_lines);
-    return model;
+    return from_xml(read_xml_string(bytes, name));
 }
 
 }  // namespace hbvh

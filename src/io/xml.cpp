@@ -27,7 +27,9 @@
 
 #include "hbvh/assert.hpp"
 #include "hbvh/io/file.hpp"
+#include "../memory/huge_pages.hpp"
 #include "xml_source.hpp"
+#include "xml_taking.hpp"
 
 namespace hbvh {
 namespace {
@@ -94,7 +96,8 @@ std::string describe_parse_error(const pugi::xml_parse_result& result) {
 }
 
 /// Shortest decimal text that reads back as exactly `value` (std::to_chars' round-trip guarantee).
-void append_number(std::string& out, double value) {
+template <class Out>
+void append_number(Out& out, double value) {
     std::array<char, 32> digits{};
     const auto [end, ec] = std::to_chars(digits.data(), digits.data() + digits.size(), value);
     out.append(digits.data(), ec == std::errc{} ? end : digits.data());
@@ -125,7 +128,7 @@ public:
     /// The lines of ascending offsets, in one forward sweep of the table (no search per offset).
     [[nodiscard]] std::vector<int> lines_of_ascending(std::span<const std::ptrdiff_t> offsets) const {
         std::vector<int> lines;
-        lines.reserve(offsets.size());
+        detail::reserve_on_huge_pages(lines, offsets.size());
         std::size_t line = 1;  // starts_[line - 1] <= offset < starts_[line]
         for (const std::ptrdiff_t offset : offsets) {
             const auto at = static_cast<std::size_t>(std::clamp<std::ptrdiff_t>(offset, 0, static_cast<std::ptrdiff_t>(size_)));
@@ -138,7 +141,7 @@ public:
 
 private:
     std::size_t size_;
-    std::vector<std::size_t> starts_;
+    detail::LargeVector<std::size_t> starts_;  // 8 MB for a 10^6-line file: on huge pages (memory/huge_pages.hpp)
 };
 
 /// Whether pugixml's in-place parse can change the white space that opens a text node: a lone '\r' becomes
@@ -168,7 +171,7 @@ struct VolumeElement {
 /// What the structure walk found. A problem of structure is reported only if no volume up to and including
 /// `problem_after` is bad: that is the order in which the one-pass reader met them.
 struct VolumeWalk {
-    std::vector<VolumeElement> volumes;
+    detail::LargeVector<VolumeElement> volumes;
     std::uint32_t primitive_count = 0;
     std::uint32_t inner_count = 0;
     pugi::xml_node second_top_level;  ///< Null when there is one top-level volume.
@@ -221,7 +224,7 @@ private:
     [[nodiscard]] Error error(int line, std::string message) const { return Error(std::move(message), source_, line); }
 
     Result<pugi::xml_node> parse_hierarchy();
-    std::optional<Error> check_structure_of(const pugi::xml_node& parent, std::vector<pugi::xml_node>& volumes) const;
+    std::optional<Error> check_structure_of(const pugi::xml_node& parent, detail::LargeVector<pugi::xml_node>& volumes) const;
     Result<VolumeWalk> walk_volumes(const pugi::xml_node& hierarchy) const;
     std::optional<Error> convert_volumes(const VolumeWalk& walk, std::vector<Primitive>& primitives,
                                          std::vector<BoundingVolume>& inner_volumes) const;
@@ -286,8 +289,11 @@ Result<XmlModel> Reader::run() {
     if (!walk) return walk.error();
 
     XmlModel model;
+    detail::reserve_on_huge_pages(model.primitives, walk->primitive_count);
     model.primitives.resize(walk->primitive_count);
-    std::vector<BoundingVolume> inner_volumes(walk->inner_count);
+    std::vector<BoundingVolume> inner_volumes;
+    detail::reserve_on_huge_pages(inner_volumes, walk->inner_count);
+    inner_volumes.resize(walk->inner_count);
     if (std::optional<Error> problem = convert_volumes(*walk, model.primitives, inner_volumes)) return *std::move(problem);
     if (!walk->nested) return model;
 
@@ -328,7 +334,8 @@ Result<pugi::xml_node> Reader::parse_hierarchy() {
 
 /// Collects the <volume> children of `parent` and rejects anything else that holds information
 /// (other elements, text). Comments and processing instructions are dropped by the parser already.
-std::optional<Error> Reader::check_structure_of(const pugi::xml_node& parent, std::vector<pugi::xml_node>& volumes) const {
+std::optional<Error> Reader::check_structure_of(const pugi::xml_node& parent,
+                                               detail::LargeVector<pugi::xml_node>& volumes) const {
     for (const pugi::xml_node& child : parent.children()) {
         switch (child.type()) {
             case pugi::node_element:
@@ -353,16 +360,17 @@ std::optional<Error> Reader::check_structure_of(const pugi::xml_node& parent, st
 /// the call stack), checking what each element contains. Problems inside <hierarchy> itself come first, as
 /// they did when this walk and the conversion were one loop; a problem inside a volume is kept for later.
 Result<VolumeWalk> Reader::walk_volumes(const pugi::xml_node& hierarchy) const {
-    std::vector<pugi::xml_node> top_level;
+    // The arrays over every volume are on huge pages (memory/huge_pages.hpp), as are the primitives below.
+    detail::LargeVector<pugi::xml_node> top_level;
     if (auto problem = check_structure_of(hierarchy, top_level)) return *std::move(problem);
     if (top_level.empty()) return error(line_of(hierarchy), "<hierarchy> contains no <volume> elements");
     VolumeWalk walk;
     walk.volumes.reserve(top_level.size());
     if (top_level.size() > 1) walk.second_top_level = top_level[1];
 
-    std::vector<std::pair<pugi::xml_node, std::uint32_t>> stack;  // (element, parent volume)
+    detail::LargeVector<std::pair<pugi::xml_node, std::uint32_t>> stack;  // (element, parent volume)
     for (auto it = top_level.rbegin(); it != top_level.rend(); ++it) stack.emplace_back(*it, no_parent);
-    std::vector<pugi::xml_node> children;
+    detail::LargeVector<pugi::xml_node> children;
     while (!stack.empty()) {
         const auto [element, parent] = stack.back();
         stack.pop_back();
@@ -425,8 +433,8 @@ std::optional<Error> Reader::convert_volume(const VolumeElement& volume, std::ve
 /// Builds the tree of a nested file and each node's line. The leaves are the primitives, numbered in
 /// document order, which `model.primitives` already holds.
 void Reader::assemble_tree(const VolumeWalk& walk, XmlModel& model, std::vector<BoundingVolume> inner_volumes) {
-    const std::vector<VolumeElement>& volumes = walk.volumes;
-    std::vector<std::ptrdiff_t> offsets;  // ascending: pre-order is document order
+    const auto& volumes = walk.volumes;
+    detail::LargeVector<std::ptrdiff_t> offsets;  // ascending: pre-order is document order
     offsets.reserve(volumes.size());
     for (const VolumeElement& volume : volumes) offsets.push_back(volume.element.offset_debug());
     const std::vector<int> element_lines = lines_.lines_of_ascending(offsets);
@@ -436,19 +444,20 @@ void Reader::assemble_tree(const VolumeWalk& walk, XmlModel& model, std::vector<
     std::string().swap(pristine_);
 
     // Each volume's children in document order, as ranges of one array (pre-order lists them in order).
-    std::vector<std::uint32_t> first_child(volumes.size() + 1, 0);
+    detail::LargeVector<std::uint32_t> first_child(volumes.size() + 1, 0);
     for (const VolumeElement& volume : volumes)
         if (volume.parent != no_parent) ++first_child[volume.parent + 1];
     for (std::size_t i = 0; i < volumes.size(); ++i) first_child[i + 1] += first_child[i];
-    std::vector<std::uint32_t> children(volumes.size());
-    std::vector<std::uint32_t> filled(first_child.begin(), first_child.end() - 1);
+    detail::LargeVector<std::uint32_t> children(volumes.size());
+    detail::LargeVector<std::uint32_t> filled(first_child.begin(), first_child.end() - 1);
     for (std::uint32_t i = 0; i < volumes.size(); ++i)
         if (volumes[i].parent != no_parent) children[filled[volumes[i].parent]++] = i;
 
     // Children come after their parent in pre-order, so walking backwards meets every child before its
     // parent, as TreeAssembler::add_group needs. It also collapses single-child volumes.
     TreeAssembler assembler(model.primitives);
-    std::vector<std::uint32_t> id(volumes.size(), 0);
+    assembler.reserve(volumes.size());
+    detail::LargeVector<std::uint32_t> id(volumes.size(), 0);
     std::vector<std::uint32_t> child_ids;
     for (std::size_t i = volumes.size(); i-- > 0;) {
         if (volumes[i].is_leaf) {
@@ -462,9 +471,9 @@ void Reader::assemble_tree(const VolumeWalk& walk, XmlModel& model, std::vector<
     std::vector<std::uint32_t> assembler_id_of_node;
     model.hierarchy = std::move(assembler).finish(id[0], &assembler_id_of_node);
 
-    std::vector<std::uint32_t> volume_of_assembler_id(volumes.size());
+    detail::LargeVector<std::uint32_t> volume_of_assembler_id(volumes.size());
     for (std::uint32_t i = 0; i < volumes.size(); ++i) volume_of_assembler_id[id[i]] = i;
-    model.node_lines.reserve(assembler_id_of_node.size());
+    detail::reserve_on_huge_pages(model.node_lines, assembler_id_of_node.size());
     for (const std::uint32_t assembler_id : assembler_id_of_node)
         model.node_lines.push_back(element_lines[volume_of_assembler_id[assembler_id]]);
 }
@@ -678,7 +687,8 @@ constexpr std::string_view declaration = "<?xml version=\"1.0\" encoding=\"UTF-8
 /// An attribute value as pugixml escapes it: & < " as entities (not >, which needs none in a value), control characters as "&#NN;" (two
 /// digits), everything else, UTF-8 included, as it is. pugixml took the value as a C string, so a name
 /// ends at its first NUL.
-void append_escaped(std::string& out, std::string_view text) {
+template <class Out>
+void append_escaped(Out& out, std::string_view text) {
     text = text.substr(0, text.find('\0'));
     for (const char c : text) {
         switch (c) {
@@ -700,7 +710,8 @@ void append_escaped(std::string& out, std::string_view text) {
 }
 
 /// ` key="n0 n1 ..."`, each number in its shortest round-trip form.
-void append_numbers(std::string& out, std::string_view key, std::initializer_list<double> values) {
+template <class Out>
+void append_numbers(Out& out, std::string_view key, std::initializer_list<double> values) {
     out += ' ';
     out += key;
     out += "=\"";
@@ -713,13 +724,16 @@ void append_numbers(std::string& out, std::string_view key, std::initializer_lis
     out += '"';
 }
 
-void append_vector(std::string& out, std::string_view key, const Vec3& v) { append_numbers(out, key, {v.x(), v.y(), v.z()}); }
+template <class Out>
+void append_vector(Out& out, std::string_view key, const Vec3& v) { append_numbers(out, key, {v.x(), v.y(), v.z()}); }
 
-void append_indent(std::string& out, std::size_t depth) { out.append(2 * depth, ' '); }
+template <class Out>
+void append_indent(Out& out, std::size_t depth) { out.append(2 * depth, ' '); }
 
 /// One <volume> start tag on its own line, `depth` levels deep. Attribute order: type, name (if any), pos,
 /// then the type's own. It is closed at once (" />") unless children follow.
-void append_volume(std::string& out, const BoundingVolume& bv, std::string_view name, std::size_t depth, bool has_children) {
+template <class Out>
+void append_volume(Out& out, const BoundingVolume& bv, std::string_view name, std::size_t depth, bool has_children) {
     append_indent(out, depth);
     out += "<volume type=\"";
     out += to_string(type_of(bv));
@@ -762,14 +776,16 @@ void append_volume(std::string& out, const BoundingVolume& bv, std::string_view 
     out += has_children ? ">\n" : " />\n";
 }
 
-void append_end_tag(std::string& out, std::size_t depth) {
+template <class Out>
+void append_end_tag(Out& out, std::size_t depth) {
     append_indent(out, depth);
     out += "</volume>\n";
 }
 
 /// The subtree under `root` as nested volumes, `depth` levels deep. Explicit stack: a degenerate
 /// (list-like) tree can be deeper than the call stack allows.
-void append_subtree(std::string& out, const Bvh& bvh, std::uint32_t root, std::size_t depth) {
+template <class Out>
+void append_subtree(Out& out, const Bvh& bvh, std::uint32_t root, std::size_t depth) {
     struct Step {
         std::uint32_t node;
         std::size_t depth;
@@ -799,32 +815,45 @@ void append_subtree(std::string& out, const Bvh& bvh, std::uint32_t root, std::s
     }
 }
 
+/// A formatting chunk's text, on huge pages from 4 MiB on (memory/huge_pages.hpp): at 10^6 volumes the chunks
+/// and the joined text are 460 MB of fresh memory, and in 4 KiB pages their faults were half the formatting.
+using ChunkText = std::basic_string<char, std::char_traits<char>, detail::HugePageAllocator<char>>;
+
 /// Appends the text of items [0, count) to `out`, `append_item(text, i)` writing item i. Many items are
 /// formatted in chunks on all cores (shortest-form numbers are most of the work) and joined in order, so
-/// the text is the same for any thread count.
+/// the text is the same for any thread count. Each chunk reserves `chunk_reserve` bytes at once where its size
+/// is known roughly: growing to it by doubling would touch twice as much memory, in small pages.
 template <class AppendItem>
-void append_items(std::string& out, std::size_t count, std::size_t items_per_chunk, const AppendItem& append_item) {
+void append_items(std::string& out, std::size_t count, std::size_t items_per_chunk, std::size_t chunk_reserve,
+                  const AppendItem& append_item) {
     const std::size_t chunk_count = (count + items_per_chunk - 1) / items_per_chunk;
     if (chunk_count <= 1) {
         for (std::size_t i = 0; i < count; ++i) append_item(out, i);
         return;
     }
-    std::vector<std::string> chunks(chunk_count);
+    std::vector<ChunkText> chunks(chunk_count);
     tbb::parallel_for(std::size_t{0}, chunk_count, [&](std::size_t chunk) {
+        chunks[chunk].reserve(chunk_reserve);
         const std::size_t end = std::min(count, (chunk + 1) * items_per_chunk);
         for (std::size_t i = chunk * items_per_chunk; i < end; ++i) append_item(chunks[chunk], i);
     });
     std::size_t size = out.size();
-    for (const std::string& chunk : chunks) size += chunk.size();
+    for (const ChunkText& chunk : chunks) size += chunk.size();
     out.reserve(size + 64);  // room for the closing tags
-    for (std::string& chunk : chunks) {
-        out += chunk;
-        std::string().swap(chunk);
+    detail::advise_huge_pages(out.data(), out.capacity());
+    for (ChunkText& chunk : chunks) {
+        out.append(chunk.data(), chunk.size());
+        ChunkText().swap(chunk);
     }
 }
 
-/// Volumes per formatting chunk: about a megabyte of text, enough to make a task worth starting.
-constexpr std::size_t volumes_per_chunk = 4096;
+/// Volumes per formatting chunk of a primitive set: about 4 MB of text, enough to make a task worth starting
+/// and to fill whole huge pages; and the bytes such a chunk reserves (an OBB's line is about 400 bytes, a
+/// sphere's 130; capacity never touched costs nothing).
+constexpr std::size_t volumes_per_chunk = 16384;
+constexpr std::size_t set_chunk_reserve = volumes_per_chunk * 512;
+/// From this many nodes on, a tree's subtrees are formatted on all cores.
+constexpr std::size_t parallel_tree_nodes = 4096;
 
 }  // namespace
 
@@ -835,9 +864,14 @@ Result<XmlModel> read_xml_string(std::string_view text, std::string_view source_
 Result<XmlModel> read_xml_file(const std::filesystem::path& path) {
     Result<std::string> text = read_text_file(path);
     if (!text) return text.error();
-    // The reader takes the file's bytes over and parses them in place: no copy of a large file.
-    return Reader(std::move(text).value(), path.string()).run();
+    return detail::read_xml_taking(std::move(text).value(), path.string());
 }
+
+namespace detail {
+Result<XmlModel> read_xml_taking(std::string text, std::string_view source_name) {
+    return Reader(std::move(text), source_name).run();
+}
+}  // namespace detail
 
 std::string write_xml(const Bvh& bvh) {
     std::string out(declaration);
@@ -850,9 +884,9 @@ std::string write_xml(const Bvh& bvh) {
         // The root's subtrees are formatted side by side, in groups of consecutive children: enough groups
         // to keep every core busy under a wide root, one subtree each under a binary one.
         append_volume(out, root.volume, {}, 1, true);
-        const bool is_large = bvh.nodes.size() >= volumes_per_chunk;
+        const bool is_large = bvh.nodes.size() >= parallel_tree_nodes;
         const std::size_t per_group = is_large ? std::max<std::size_t>(1, root.child_count / 64) : root.child_count;
-        append_items(out, root.child_count, per_group, [&](std::string& text, std::size_t c) {
+        append_items(out, root.child_count, per_group, 0, [&](auto& text, std::size_t c) {
             append_subtree(text, bvh, root.first_child + static_cast<std::uint32_t>(c), 2);
         });
         append_end_tag(out, 1);
@@ -865,7 +899,7 @@ std::string write_primitives_xml(std::span<const Primitive> primitives) {
     std::string out(declaration);
     if (primitives.empty()) return out + "<hierarchy />\n";
     out += "<hierarchy>\n";
-    append_items(out, primitives.size(), volumes_per_chunk, [&](std::string& text, std::size_t i) {
+    append_items(out, primitives.size(), volumes_per_chunk, set_chunk_reserve, [&](auto& text, std::size_t i) {
         append_volume(text, primitives[i].volume, primitives[i].name, 1, false);
     });
     out += "</hierarchy>\n";

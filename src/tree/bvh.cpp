@@ -5,6 +5,7 @@
 #include <deque>
 
 #include "hbvh/assert.hpp"
+#include "../memory/huge_pages.hpp"
 
 namespace hbvh {
 
@@ -37,8 +38,14 @@ std::vector<std::uint32_t> covered_primitives(const Bvh& bvh, std::uint32_t inde
     return out;
 }
 
-TreeAssembler::TreeAssembler(std::span<const Primitive> primitives)
-    : primitives_(primitives.begin(), primitives.end()) {}
+// The arrays over every primitive and node are on huge pages (memory/huge_pages.hpp): a tree read from a file
+// of 10^6 primitives first-touches about 0.7 GB here.
+TreeAssembler::TreeAssembler(std::span<const Primitive> primitives) {
+    detail::reserve_on_huge_pages(primitives_, primitives.size());
+    primitives_.assign(primitives.begin(), primitives.end());
+}
+
+void TreeAssembler::reserve(std::size_t items) { detail::reserve_on_huge_pages(items_, items); }
 
 std::uint32_t TreeAssembler::add_leaf(std::uint32_t primitive) {
     HBVH_ASSERT(primitive < primitives_.size());
@@ -64,6 +71,7 @@ Bvh TreeAssembler::finish(std::uint32_t root, std::vector<std::uint32_t>* id_of_
     Bvh bvh;
     bvh.primitives = std::move(primitives_);
     if (items_.empty()) return bvh;
+    detail::reserve_on_huge_pages(bvh.nodes, items_.size());  // each item is placed at most once
 
     // Breadth-first layout: a node's children are appended together, so they are contiguous.
     std::deque<std::pair<std::uint32_t, std::uint32_t>> queue;  // (item id, node index)
@@ -71,6 +79,7 @@ Bvh TreeAssembler::finish(std::uint32_t root, std::vector<std::uint32_t>* id_of_
     bvh.nodes.push_back({items_[root].volume, 0, 0, items_[root].primitive});
     queue.emplace_back(root, 0);
     std::vector<std::pair<std::uint32_t, std::uint32_t>> placed;  // (item id, node index), for id_of_node
+    if (id_of_node != nullptr) detail::reserve_on_huge_pages(placed, items_.size());
     while (!queue.empty()) {
         const auto [id, index] = queue.front();
         queue.pop_front();
@@ -86,6 +95,7 @@ Bvh TreeAssembler::finish(std::uint32_t root, std::vector<std::uint32_t>* id_of_
         }
     }
     if (id_of_node != nullptr) {
+        detail::reserve_on_huge_pages(*id_of_node, bvh.nodes.size());
         id_of_node->resize(bvh.nodes.size());
         for (const auto& [id, index] : placed) (*id_of_node)[index] = id;
     }

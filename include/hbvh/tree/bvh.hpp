@@ -46,6 +46,9 @@ class TreeAssembler {
 public:
     explicit TreeAssembler(std::span<const Primitive> primitives);
 
+    /// Room for `items` leaves and groups, so that a large tree's items are written once (and on huge pages).
+    void reserve(std::size_t items);
+
     /// The leaf for input primitive `primitive`; its BV is the primitive's own.
     std::uint32_t add_leaf(std::uint32_t primitive);
     /// A group over `children` (ids from earlier calls) with BV `volume`.
