@@ -311,28 +311,13 @@ int line_of(const Hierarchy& h, std::uint32_t node) { return node < h.node_lines
 py::object load(const std::string& path, const std::string& format, bool refit) {
     Result<ModelFile> read = read_model_file(path, format);
     if (!read) raise(read.error());
-    Primitives primitives{std::move(read->primitives), std::move(read->warnings)};
-    std::optional<Bvh> hierarchy = std::move(read->hierarchy);
-    std::vector<int> node_lines = std::move(read->node_lines);
-    // The checks of load_model, then the containment check every CLI command but stats makes.
-    if (Status valid = validate_primitives(primitives.items); !valid) raise(Error{valid.error().message, path});
-    if (Status finite = check_finite_extent(primitives.items); !finite) raise(Error{finite.error().message, path});
-    if (!hierarchy) return py::cast(std::move(primitives));
-    if (Status structure = check_structure(*hierarchy); !structure) raise(Error{structure.error().message, path});
-    Hierarchy result = Hierarchy::from(std::move(*hierarchy), std::move(node_lines));
-    const std::vector<ContainmentViolation> violations = containment_violations(result.bvh);
-    if (!violations.empty()) {
-        if (!refit) {
-            std::string message = describe_violation(result.bvh, violations.front());
-            if (violations.size() > 1) message += " (and " + std::to_string(violations.size() - 1) + " more volumes)";
-            raise(Error{message + "; load(..., refit=True) refits them", path, line_of(result, violations.front().node)});
-        }
-        Bvh repaired = result.bvh;
-        refit_non_enclosing(repaired);
-        if (Status valid = validate(repaired); !valid) raise(Error{"after refit: " + valid.error().message, path});
-        result = Hierarchy::from(std::move(repaired), std::move(result.node_lines));
-    }
-    return py::cast(std::move(result));
+    // The checks of the CLI's load_model, then the containment check every CLI command but stats makes.
+    if (Status checked = check_model_file(*read, path); !checked) raise(checked.error());
+    if (!read->hierarchy) return py::cast(Primitives{std::move(read->primitives), std::move(read->warnings)});
+    Result<Bvh> enclosing =
+        enclosing_hierarchy(std::move(*read->hierarchy), read->node_lines, path, refit, "load(..., refit=True)");
+    if (!enclosing) raise(enclosing.error());
+    return py::cast(Hierarchy::from(std::move(enclosing).value(), std::move(read->node_lines)));
 }
 
 void save(const Hierarchy& h, const std::string& path) {

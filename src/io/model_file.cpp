@@ -12,8 +12,12 @@
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/import.hpp"
 #include "hbvh/io/mesh_import.hpp"
+#include "hbvh/builders/build.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/tree/binary_format.hpp"
+#include "hbvh/tree/refit.hpp"
+#include "hbvh/tree/validate.hpp"
 #include "xml_taking.hpp"
 
 namespace hbvh {
@@ -99,6 +103,33 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
             return from_xml(detail::read_xml_taking(std::move(text).value(), path));
     }
     return from_import(import_primitives(path, chosen->second), path);
+}
+
+Status check_model_file(const ModelFile& model, const std::string& source) {
+    if (Status valid = validate_primitives(model.primitives); !valid) return Error{valid.error().message, source};
+    if (Status finite = check_finite_extent(model.primitives); !finite) return Error{finite.error().message, source};
+    if (model.hierarchy)
+        if (Status structure = check_structure(*model.hierarchy); !structure) return Error{structure.error().message, source};
+    return Ok{};
+}
+
+Result<Bvh> enclosing_hierarchy(Bvh stored, std::span<const int> node_lines, const std::string& source,
+                                bool refit, std::string_view refit_option, std::size_t* refitted) {
+    if (refitted != nullptr) *refitted = 0;
+    const std::vector<ContainmentViolation> violations = containment_violations(stored);
+    if (violations.empty()) return stored;
+    if (!refit) {
+        const ContainmentViolation& first = violations.front();
+        std::string message = describe_violation(stored, first);
+        if (violations.size() > 1) message += " (and " + std::to_string(violations.size() - 1) + " more volumes)";
+        const int line = first.node < node_lines.size() ? node_lines[first.node] : 0;
+        return Error{message + "; " + std::string(refit_option) + " refits them", source, line};
+    }
+    const std::size_t count = refit_non_enclosing(stored);
+    if (Status valid = validate(stored); !valid)
+        return Error{"after " + std::string(refit_option) + ": " + valid.error().message, source};
+    if (refitted != nullptr) *refitted = count;
+    return stored;
 }
 
 Result<ModelFile> read_model_bytes(std::string_view bytes, const std::string& name) {

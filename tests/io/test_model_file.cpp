@@ -4,6 +4,7 @@
 // with their reasons, and the refusals the CLI and the Python module rely on.
 #include "hbvh/io/model_file.hpp"
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 #include <sstream>
@@ -15,6 +16,7 @@
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/tree/binary_format.hpp"
+#include "hbvh/tree/validate.hpp"
 #include "io/import_test_support.hpp"
 #include "io/sample_hierarchy.hpp"
 
@@ -128,6 +130,70 @@ TEST_F(ModelFileTest, RefusesDirectoriesUnknownFormatsAndFilesWithoutPrimitives)
     ASSERT_FALSE(empty.has_value());
     EXPECT_EQ(empty.error().message.rfind("the file holds no collision primitives: ", 0), 0u) << empty.error().message;
     EXPECT_NE(empty.error().message.find("; and 1 more"), std::string::npos) << empty.error().message;
+}
+
+TEST_F(ModelFileTest, ChecksRefuseBadPrimitivesAndBrokenTreesNamingTheSource) {
+    ModelFile model;
+    model.primitives = {{Sphere{Vec3(0, 0, 0), 1}, "a"}, {Sphere{Vec3(1, 0, 0), -2}, "b"}};
+    const Status negative = check_model_file(model, "m.xml");
+    ASSERT_FALSE(negative.has_value());
+    EXPECT_EQ(negative.error().file, "m.xml");
+    EXPECT_NE(negative.error().message.find("primitive 1 ('b')"), std::string::npos) << negative.error().message;
+
+    model.primitives[1].volume = Sphere{Vec3(1, 0, 0), 2};
+    EXPECT_TRUE(check_model_file(model, "m.xml").has_value());
+    Bvh tree = test::sample_hierarchy();
+    tree.nodes[0].first_child = static_cast<std::uint32_t>(tree.nodes.size());  // children past the end
+    model.primitives = tree.primitives;
+    model.hierarchy = tree;
+    const Status broken = check_model_file(model, "m.xml");
+    ASSERT_FALSE(broken.has_value());
+    EXPECT_EQ(broken.error().file, "m.xml");
+}
+
+TEST_F(ModelFileTest, EnclosingHierarchyNamesTheFirstBadVolumeOrRefitsOnlyTheBadOnes) {
+    // The appendix's tree with its volumes as printed: eight do not enclose their primitives (docs/bad-input.md).
+    const std::string file = (fs::path(HBVH_SOURCE_DIR) / "tests/io/data/survey_appendix_b_repaired.xml").string();
+    const Result<ModelFile> read = read_model_file(file);
+    ASSERT_TRUE(read.has_value()) << read.error().to_string();
+    ASSERT_TRUE(check_model_file(*read, file).has_value());
+    const Bvh& stored = *read->hierarchy;
+    const std::vector<ContainmentViolation> violations = containment_violations(stored);
+    ASSERT_EQ(violations.size(), 8u);
+
+    const Result<Bvh> refused = enclosing_hierarchy(stored, read->node_lines, file, false, "--refit");
+    ASSERT_FALSE(refused.has_value());
+    EXPECT_EQ(refused.error().file, file);
+    EXPECT_EQ(refused.error().line, read->node_lines[violations.front().node]);
+    EXPECT_EQ(refused.error().message, describe_violation(stored, violations.front()) + " (and 7 more volumes); --refit refits them");
+
+    std::size_t refitted = 0;
+    const Result<Bvh> repaired = enclosing_hierarchy(stored, read->node_lines, file, true, "--refit", &refitted);
+    ASSERT_TRUE(repaired.has_value()) << repaired.error().to_string();
+    EXPECT_TRUE(containment_violations(*repaired).empty());
+    // The same tree, and only volumes that were wrong changed.
+    ASSERT_EQ(repaired->nodes.size(), stored.nodes.size());
+    std::size_t changed = 0;
+    for (std::size_t i = 0; i < stored.nodes.size(); ++i) {
+        EXPECT_EQ(repaired->nodes[i].first_child, stored.nodes[i].first_child);
+        EXPECT_EQ(repaired->nodes[i].child_count, stored.nodes[i].child_count);
+        EXPECT_EQ(type_of(repaired->nodes[i].volume), type_of(stored.nodes[i].volume)) << i;
+        if (test::compare_volumes(repaired->nodes[i].volume, stored.nodes[i].volume, 0.0).empty()) continue;
+        ++changed;
+        const bool was_bad = std::any_of(violations.begin(), violations.end(),
+                                         [&](const ContainmentViolation& v) { return v.node == i; });
+        EXPECT_TRUE(was_bad) << "node " << i << " enclosed its primitives and was refitted anyway";
+    }
+    EXPECT_EQ(changed, refitted);
+    EXPECT_GE(refitted, 1u);
+
+    // A sound tree comes back as it is.
+    const Bvh sound = *repaired;
+    std::size_t none = 99;
+    const Result<Bvh> kept = enclosing_hierarchy(sound, {}, "x.hbvh", false, "--refit", &none);
+    ASSERT_TRUE(kept.has_value());
+    EXPECT_EQ(none, 0u);
+    EXPECT_EQ(write_binary(*kept), write_binary(sound));
 }
 
 }  // namespace

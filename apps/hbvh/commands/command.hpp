@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "hbvh/builders/build.hpp"
+#include "hbvh/io/model_file.hpp"
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -37,12 +38,8 @@ void add_view_command(CLI::App& app, Command& command);
 void add_calibrate_command(CLI::App& app, Command& command);
 
 /// A loaded input: always the primitives; the hierarchy too when the file nests volumes.
-struct Model {
-    std::vector<Primitive> primitives;
-    std::optional<Bvh> hierarchy;
-    std::vector<std::string> warnings;
-    std::string source;           ///< The input's name in messages ("<stdin>" for "-").
-    std::vector<int> node_lines;  ///< With a hierarchy: each node's line in the file (XmlModel::node_lines).
+struct Model : ModelFile {
+    std::string source;  ///< The input's name in messages ("<stdin>" for "-").
 };
 
 /// Reads INPUT ("-" = stdin) in the format its extension says, or `format` when given.

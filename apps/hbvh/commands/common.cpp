@@ -9,10 +9,8 @@
 #include <iterator>
 
 #include "commands/command.hpp"
-#include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/model_file.hpp"
-#include "hbvh/tree/refit.hpp"
 
 namespace hbvh::cli {
 
@@ -30,8 +28,7 @@ Result<ModelFile> read_standard_input(const std::string& format) {
 Result<Model> read_model(const std::string& path, const std::string& format) {
     Result<ModelFile> read = path == "-" ? read_standard_input(format) : read_model_file(path, format);
     if (!read) return read.error();
-    return Model{std::move(read->primitives), std::move(read->hierarchy), std::move(read->warnings), {},
-                 std::move(read->node_lines)};
+    return Model{std::move(read).value(), {}};
 }
 }  // namespace
 
@@ -40,11 +37,7 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
     if (!model) return model;
     model->source = path == "-" ? "<stdin>" : path;
     // Refused here rather than in build() so that the message names the file.
-    if (Status valid = validate_primitives(model->primitives); !valid) return Error{valid.error().message, model->source};
-    if (Status finite = check_finite_extent(model->primitives); !finite) return Error{finite.error().message, model->source};
-    if (model->hierarchy)
-        if (Status structure = check_structure(*model->hierarchy); !structure)
-            return Error{structure.error().message, model->source};
+    if (Status checked = check_model_file(*model, model->source); !checked) return checked.error();
     return model;
 }
 
@@ -148,20 +141,13 @@ namespace {
 /// The stored hierarchy if every volume encloses its primitives; with --refit, repaired; else the Error
 /// naming the first bad volume's line.
 Result<Bvh> checked_stored_hierarchy(const Model& model, const BuilderFlags& flags) {
-    const Bvh& stored = *model.hierarchy;
-    const std::vector<ContainmentViolation> violations = containment_violations(stored);
-    if (violations.empty()) return stored;
-    if (!flags.refit) {
-        std::string message = describe_violation(stored, violations.front());
-        if (violations.size() > 1) message += fmt::format(" (and {} more volumes)", violations.size() - 1);
-        return Error{message + "; --refit refits them", model.source, line_of_node(model, violations.front().node)};
-    }
-    Bvh repaired = stored;
-    const std::size_t refitted = refit_non_enclosing(repaired);
-    if (Status valid = validate(repaired); !valid) return Error{"after --refit: " + valid.error().message, model.source};
-    fmt::print(stderr, "hbvh: {}: refitted {} of {} volumes that did not enclose their primitives\n", model.source,
-               refitted, stored.nodes.size());
-    return repaired;
+    std::size_t refitted = 0;
+    Result<Bvh> checked =
+        enclosing_hierarchy(*model.hierarchy, model.node_lines, model.source, flags.refit, "--refit", &refitted);
+    if (checked && refitted > 0)
+        fmt::print(stderr, "hbvh: {}: refitted {} of {} volumes that did not enclose their primitives\n", model.source,
+                   refitted, model.hierarchy->nodes.size());
+    return checked;
 }
 }  // namespace
 

@@ -3,7 +3,9 @@
 // the Python module read their inputs through it, so a file is read, and refused, the same way everywhere.
 #pragma once
 
+#include <cstddef>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -31,6 +33,21 @@ struct ModelFile {
 /// no primitive (with the first three candidates the importer skipped, and why). Nothing is checked across
 /// primitives or nodes: validate_primitives, check_structure and containment_violations are the caller's.
 [[nodiscard]] Result<ModelFile> read_model_file(const std::string& path, std::string_view format = {});
+
+/// The checks to make on what read_model_file returns before using it, as the CLI and the Python module make them:
+/// the primitives (validate_primitives, check_finite_extent) and a stored hierarchy's structure
+/// (check_structure). Errors carry `source` as their file.
+[[nodiscard]] Status check_model_file(const ModelFile& model, const std::string& source);
+
+/// A stored hierarchy fit to query: the tree itself when every volume encloses its primitives. Otherwise, without
+/// `refit`, an Error naming the first volume that does not (at its line in a survey XML, from `node_lines`) and
+/// how many more there are, and saying that `refit_option` (the caller's name for the repair: "--refit" in the
+/// CLI) refits them; with `refit`, the tree with each such volume refitted (same kind, tree kept; refit.hpp), and
+/// in `*refitted` how many were. Precondition: `stored` passed check_structure (check_model_file). The tree is
+/// taken by value: move it in when it is not needed afterwards (at 10^6 primitives a copy is 300 MB).
+[[nodiscard]] Result<Bvh> enclosing_hierarchy(Bvh stored, std::span<const int> node_lines,
+                                              const std::string& source, bool refit, std::string_view refit_option,
+                                              std::size_t* refitted = nullptr);
 
 /// Survey XML or .hbvh bytes already in memory (an asset taken from an archive, standard input), read as
 /// read_model_file reads such a file; `name` goes into errors.
