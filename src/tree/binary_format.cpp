@@ -1,11 +1,7 @@
 // SPDX-License-Identifier: MIT
-// The .hbvh binary format (docs/formats.md, "The binary format"): explicit little-endian fields, CRC-64/XZ.
+// The .hbvh binary format (docs/formats.md, "The binary format"): its records encoded and decoded, explicit
+// little-endian fields. The checksum is crc64.cpp; files (mapping, the atomic write) are binary_file.cpp.
 #include "hbvh/tree/binary_format.hpp"
-
-#include <fcntl.h>
-#include <sys/mman.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
@@ -21,19 +17,21 @@
 #include <system_error>
 #include <vector>
 
-#if defined(__x86_64__)
-#include <immintrin.h>
-#endif
-
 #include <tbb/task_group.h>
 
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/validate.hpp"
 #include "../memory/huge_pages.hpp"
 #include "binary_decoding.hpp"
+#include "little_endian.hpp"
 
 namespace hbvh {
 namespace {
+
+using detail::load_u32_le;
+using detail::load_u64_le;
+using detail::store_u32_le;
+using detail::store_u64_le;
 
 // Sizes of the fixed parts (docs/formats.md's layout table).
 constexpr std::size_t binary_header_size = 40;  // magic 8, version 4, flags 4, file size 8, node and primitive counts 8 + 8
@@ -47,119 +45,6 @@ constexpr std::size_t binary_min_primitive_size = binary_min_volume_size + 4;  /
 /// Doubles stored for each BvType, in variant order: aabb min, max; obb centre, rotation (row-major),
 /// half extents; sphere centre, radius; capsule p0, p1, radius.
 constexpr std::array<std::size_t, bv_type_count> binary_double_count{6, 15, 4, 7};
-
-// CRC-64/XZ by slicing-by-8 (Kounavis & Berry's table method): eight tables let the loop fold 8 input bytes
-// per step instead of one. It runs where the carry-less multiply below does not, and for the short ends.
-constexpr std::uint64_t crc64_polynomial = 0x42F0E1EBA9EA3693ULL;
-constexpr std::uint64_t crc64_reflected_polynomial = 0xC96C5795D7870F42ULL;  // the same, bit-reversed
-
-using Crc64Tables = std::array<std::array<std::uint64_t, 256>, 8>;
-constexpr Crc64Tables make_crc64_tables() {
-    Crc64Tables tables{};
-    for (std::uint64_t i = 0; i < 256; ++i) {
-        std::uint64_t crc = i;
-        for (int bit = 0; bit < 8; ++bit) crc = (crc & 1) != 0 ? (crc >> 1) ^ crc64_reflected_polynomial : crc >> 1;
-        tables[0][i] = crc;
-    }
-    // tables[k][i]: the CRC of byte i followed by k zero bytes.
-    for (std::size_t k = 1; k < 8; ++k)
-        for (std::size_t i = 0; i < 256; ++i)
-            tables[k][i] = (tables[k - 1][i] >> 8) ^ tables[0][tables[k - 1][i] & 0xFF];
-    return tables;
-}
-constexpr Crc64Tables crc64_tables = make_crc64_tables();
-
-std::uint64_t load_u64_le(const unsigned char* p) {
-    std::uint64_t value = 0;
-    if constexpr (std::endian::native == std::endian::little) {
-        std::memcpy(&value, p, sizeof value);  // one load; the byte loop below is its meaning
-    } else {
-        for (int i = 7; i >= 0; --i) value = (value << 8) | p[i];
-    }
-    return value;
-}
-std::uint32_t load_u32_le(const unsigned char* p) {
-    return std::uint32_t{p[0]} | std::uint32_t{p[1]} << 8 | std::uint32_t{p[2]} << 16 | std::uint32_t{p[3]} << 24;
-}
-void store_u64_le(unsigned char* p, std::uint64_t value) {
-    for (int i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(value >> (8 * i));
-}
-void store_u32_le(unsigned char* p, std::uint32_t value) {
-    for (int i = 0; i < 4; ++i) p[i] = static_cast<unsigned char>(value >> (8 * i));
-}
-
-/// The CRC register after `n` more bytes at `p`, by the tables (no initial value or final xor applied).
-std::uint64_t crc64_update_by_table(std::uint64_t crc, const unsigned char* p, std::size_t n) {
-    const Crc64Tables& t = crc64_tables;
-    for (; n >= 8; n -= 8, p += 8) {
-        crc ^= load_u64_le(p);
-        crc = t[7][crc & 0xFF] ^ t[6][(crc >> 8) & 0xFF] ^ t[5][(crc >> 16) & 0xFF] ^ t[4][(crc >> 24) & 0xFF] ^
-              t[3][(crc >> 32) & 0xFF] ^ t[2][(crc >> 40) & 0xFF] ^ t[1][(crc >> 48) & 0xFF] ^ t[0][crc >> 56];
-    }
-    for (; n > 0; --n, ++p) crc = (crc >> 8) ^ t[0][(crc ^ *p) & 0xFF];
-    return crc;
-}
-
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define HBVH_CRC64_CLMUL 1
-// CRC-64/XZ by carry-less multiplication (Gopal et al., "Fast CRC computation for generic polynomials using
-// PCLMULQDQ", Intel 2009): four 16-byte accumulators are folded 64 bytes forward per step, each by two
-// 64 x 64-bit carry-less products with x^k mod P, which keeps the checksum near memory speed (a 150 MB file
-// in about 11 ms instead of 78 ms by the tables). The folded 16 bytes and the tail go through the tables,
-// which replaces the Barrett reduction. Bit-reflected throughout: bit 0 of a little-endian word is the
-// highest power of x, and the 127-bit product of two reflected words is one power of x short, hence the
-// exponent - 1 below. Checked against the tables for every length up to thousands of bytes (the unit test).
-
-constexpr std::uint64_t reflect_bits(std::uint64_t value) {
-    std::uint64_t reflected = 0;
-    for (int i = 0; i < 64; ++i)
-        if ((value >> i & 1) != 0) reflected |= std::uint64_t{1} << (63 - i);
-    return reflected;
-}
-/// x^(exponent - 1) mod P, bit-reflected: multiplying a reflected word by it moves that word `exponent`
-/// bits (exponent / 8 bytes) further along the message.
-constexpr std::uint64_t crc64_fold_constant(unsigned exponent) {
-    std::uint64_t remainder = 1;
-    for (unsigned i = 0; i + 1 < exponent; ++i) remainder = (remainder << 1) ^ ((remainder >> 63) != 0 ? crc64_polynomial : 0);
-    return reflect_bits(remainder);
-}
-
-// Folding by 64 bytes (4 accumulators) and by 16 (one): [0] for an accumulator's first 8 bytes, [1] for the next 8.
-constexpr std::array<std::uint64_t, 2> crc64_fold_by_64{crc64_fold_constant(512 + 64), crc64_fold_constant(512)};
-constexpr std::array<std::uint64_t, 2> crc64_fold_by_16{crc64_fold_constant(128 + 64), crc64_fold_constant(128)};
-
-__attribute__((target("pclmul"))) inline __m128i crc64_fold(__m128i x, __m128i constants) {
-    return _mm_xor_si128(_mm_clmulepi64_si128(x, constants, 0x00), _mm_clmulepi64_si128(x, constants, 0x11));
-}
-
-/// The CRC register after `n` >= 64 bytes at `p`, starting from `crc`.
-__attribute__((target("pclmul"))) std::uint64_t crc64_update_by_clmul(std::uint64_t crc, const unsigned char* p,
-                                                                         std::size_t n) {
-    auto constants = [](const std::array<std::uint64_t, 2>& c) {
-        return _mm_set_epi64x(static_cast<long long>(c[1]), static_cast<long long>(c[0]));
-    };
-    const __m128i by_64_bytes = constants(crc64_fold_by_64), by_16_bytes = constants(crc64_fold_by_16);
-    auto load = [](const unsigned char* at) { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(at)); };
-    // The register is xored into the first 8 bytes, as the tables' loop does.
-    __m128i x0 = _mm_xor_si128(load(p), _mm_set_epi64x(0, static_cast<long long>(crc)));
-    __m128i x1 = load(p + 16), x2 = load(p + 32), x3 = load(p + 48);
-    p += 64;
-    n -= 64;
-    for (; n >= 64; n -= 64, p += 64) {
-        x0 = _mm_xor_si128(crc64_fold(x0, by_64_bytes), load(p));
-        x1 = _mm_xor_si128(crc64_fold(x1, by_64_bytes), load(p + 16));
-        x2 = _mm_xor_si128(crc64_fold(x2, by_64_bytes), load(p + 32));
-        x3 = _mm_xor_si128(crc64_fold(x3, by_64_bytes), load(p + 48));
-    }
-    x1 = _mm_xor_si128(x1, crc64_fold(x0, by_16_bytes));
-    x2 = _mm_xor_si128(x2, crc64_fold(x1, by_16_bytes));
-    x3 = _mm_xor_si128(x3, crc64_fold(x2, by_16_bytes));
-    for (; n >= 16; n -= 16, p += 16) x3 = _mm_xor_si128(crc64_fold(x3, by_16_bytes), load(p));
-    unsigned char folded[16];
-    _mm_storeu_si128(reinterpret_cast<__m128i*>(folded), x3);
-    return crc64_update_by_table(crc64_update_by_table(0, folded, sizeof folded), p, n);
-}
-#endif
 
 /// The numbers of a volume in file order.
 std::size_t volume_doubles(const BoundingVolume& volume, std::array<double, 15>& out) {
@@ -383,7 +268,7 @@ long long leading_index(const std::string& message, std::string_view word) {
     return static_cast<long long>(index);
 }
 
-std::string describe_errno(int code) { return std::generic_category().message(code); }
+
 
 /// True when every byte of `text` is ASCII other than NUL: the common name, which then needs no UTF-8 decoding.
 bool is_plain_ascii(std::string_view text) {
@@ -514,16 +399,6 @@ DecodeOutcome decode_primitive_records(const unsigned char* data, std::size_t en
 
 }  // namespace
 
-std::uint64_t crc64_xz(std::span<const std::byte> bytes) {
-    const auto* p = reinterpret_cast<const unsigned char*>(bytes.data());
-    const std::uint64_t initial = ~std::uint64_t{0};
-#ifdef HBVH_CRC64_CLMUL
-    // Below a few hundred bytes the tables are as fast; the CPU check reads a flag the runtime set at start-up.
-    if (bytes.size() >= 256 && __builtin_cpu_supports("pclmul")) return ~crc64_update_by_clmul(initial, p, bytes.size());
-#endif
-    return ~crc64_update_by_table(initial, p, bytes.size());
-}
-
 bool has_binary_magic(std::span<const std::byte> bytes) {
     return bytes.size() >= binary_magic.size() &&
            std::memcmp(bytes.data(), binary_magic.data(), binary_magic.size()) == 0;
@@ -563,9 +438,6 @@ std::string write_binary(const Bvh& bvh) {
     writer.u64(crc);
     return out;
 }
-
-/// Files from this size on are mapped rather than read (below it, one read() is as fast and needs no mapping).
-constexpr std::uint64_t mapped_read_bytes = std::uint64_t{1} << 20;
 
 namespace detail {
 
@@ -685,73 +557,6 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     return decoded;
 }
 
-Status with_file_bytes(const std::filesystem::path& path, const std::function<void(std::span<const std::byte>)>& use) {
-    const std::string name = path.string();
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) return Error{"cannot open for reading: " + describe_errno(errno), name};
-    struct stat info {};
-    // An uninitialised buffer (a vector would zero it first, one more pass over a large file), sized from
-    // st_size and advised into huge pages like the Bvh; st_size is only a hint (a pipe has none, a file can
-    // grow), so the loop reads to the end whatever it says and grows the buffer when it must.
-    std::unique_ptr<std::byte[]> bytes;
-    std::size_t capacity = 0, filled = 0;
-    int failure = 0;
-    if (::fstat(fd, &info) != 0) failure = errno;
-    else if (S_ISDIR(info.st_mode)) failure = EISDIR;
-    else if (S_ISREG(info.st_mode) && static_cast<std::uint64_t>(info.st_size) >= mapped_read_bytes) {
-        // A large regular file is mapped instead: its pages are the page cache's own, so there is no buffer to
-        // clear and fill (at 10^6 primitives, 153 MB: about a quarter of the whole load). MAP_POPULATE maps them
-        // all at once rather than one fault per page. A file of the wrong kind or size is refused as before.
-        const auto length = static_cast<std::size_t>(info.st_size);
-        void* mapped = ::mmap(nullptr, length, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
-        if (mapped != MAP_FAILED) {
-            ::close(fd);
-            use(std::span<const std::byte>(static_cast<const std::byte*>(mapped), length));
-            ::munmap(mapped, length);
-            return Ok{};
-        }
-        // Where mapping is refused (some file systems), read it.
-    }
-    if (failure == 0 && !S_ISDIR(info.st_mode)) {
-        capacity = S_ISREG(info.st_mode) && info.st_size > 0 ? static_cast<std::size_t>(info.st_size) : 65536;
-        bytes.reset(new std::byte[capacity]);
-        detail::advise_huge_pages(bytes.get(), capacity);
-        for (;;) {
-            if (filled == capacity) {
-                // Full: look for more in a small buffer before doubling, so that a file of exactly st_size bytes
-                // (the usual case) is not copied into twice the memory just to find its end.
-                std::byte probe[4096];
-                ssize_t got = ::read(fd, probe, sizeof probe);
-                if (got < 0 && errno == EINTR) continue;
-                if (got < 0) {
-                    failure = errno;
-                    break;
-                }
-                if (got == 0) break;
-                capacity = std::max(2 * capacity, filled + sizeof probe + 65536);
-                std::unique_ptr<std::byte[]> larger(new std::byte[capacity]);
-                std::memcpy(larger.get(), bytes.get(), filled);
-                std::memcpy(larger.get() + filled, probe, static_cast<std::size_t>(got));
-                bytes = std::move(larger);
-                filled += static_cast<std::size_t>(got);
-                continue;
-            }
-            const ssize_t got = ::read(fd, bytes.get() + filled, capacity - filled);
-            if (got < 0 && errno == EINTR) continue;
-            if (got < 0) {
-                failure = errno;
-                break;
-            }
-            if (got == 0) break;
-            filled += static_cast<std::size_t>(got);
-        }
-    }
-    ::close(fd);
-    if (failure != 0) return Error{"cannot read: " + describe_errno(failure), name};
-    use(std::span<const std::byte>(bytes.get(), filled));
-    return Ok{};
-}
-
 }  // namespace detail
 
 Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view source_name) {
@@ -804,63 +609,6 @@ Result<Bvh> read_binary(std::span<const std::byte> bytes, std::string_view sourc
         return Error{"offset " + std::to_string(offset) + ": " + message, file};
     }
     return bvh;
-}
-
-Result<Bvh> read_binary_file(const std::filesystem::path& path) {
-    std::optional<Result<Bvh>> bvh;
-    const Status read = detail::with_file_bytes(path, [&](std::span<const std::byte> bytes) { bvh = read_binary(bytes, path.string()); });
-    if (!read) return read.error();
-    return std::move(*bvh);
-}
-
-Status write_binary_file(const std::filesystem::path& path, const Bvh& bvh) {
-    const std::string name = path.string();
-    if (path.empty() || !path.has_filename()) return Error{"not a file name", name};
-    const std::string content = write_binary(bvh);
-    // A hidden temporary next to the target (same file system, so rename() is atomic); O_EXCL never
-    // opens someone else's file. The io library's write_file_atomic does the same; core cannot use it.
-    static std::atomic<unsigned> counter{0};
-    std::filesystem::path temporary;
-    int fd = -1;
-    for (unsigned attempt = 0; attempt < 100 && fd < 0; ++attempt) {
-        std::string hidden(1, '.');
-        hidden += path.filename().string();
-        hidden += ".tmp-";
-        hidden += std::to_string(::getpid());
-        hidden += '-';
-        hidden += std::to_string(counter.fetch_add(1));
-        temporary = path.parent_path() / hidden;
-        fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-        if (fd < 0 && errno != EEXIST && errno != EINTR) break;
-    }
-    if (fd < 0) return Error{"cannot create a temporary file next to it: " + describe_errno(errno), name};
-    auto fail = [&](const std::string& what, int code) -> Status {
-        ::close(fd);
-        ::unlink(temporary.c_str());
-        return Error{what + ": " + describe_errno(code), name};
-    };
-    // An existing file keeps its permission bits.
-    struct stat existing {};
-    if (::stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode) && ::fchmod(fd, existing.st_mode & 07777) != 0)
-        return fail("cannot set permissions", errno);
-    for (std::string_view rest = content; !rest.empty();) {
-        const ssize_t written = ::write(fd, rest.data(), rest.size());
-        if (written < 0 && errno == EINTR) continue;
-        if (written < 0) return fail("cannot write", errno);
-        rest.remove_prefix(static_cast<std::size_t>(written));
-    }
-    if (::fsync(fd) != 0) return fail("cannot flush to disk", errno);
-    if (::close(fd) != 0) {
-        const int code = errno;
-        ::unlink(temporary.c_str());
-        return Error{"cannot write: " + describe_errno(code), name};
-    }
-    if (::rename(temporary.c_str(), path.c_str()) != 0) {
-        const int code = errno;
-        ::unlink(temporary.c_str());
-        return Error{"cannot rename the temporary file over it: " + describe_errno(code), name};
-    }
-    return Ok{};
 }
 
 }  // namespace hbvh
