@@ -98,7 +98,6 @@ std::string describe_parse_error(const pugi::xml_parse_result& result) {
     }
 }
 
-
 /// Where every line of a text starts. Built before pugixml parses the text in place, because that parse
 /// rewrites line ends ("\r\n" and newlines inside attribute values); a lookup is a binary search, so an
 /// error deep in a large file costs no scan of the text before it.
