@@ -60,6 +60,56 @@ TEST(TreeAssembler, CollapsesSingleChildChains) {
     EXPECT_TRUE(validate(bvh).has_value());
 }
 
+/// A balanced tree over `count` unit boxes, pairs grouped level by level; `reserved` items reserved first.
+Bvh paired_tree(std::uint32_t count, std::size_t reserved, std::vector<std::uint32_t>* id_of_node) {
+    std::vector<Primitive> primitives;
+    for (std::uint32_t i = 0; i < count; ++i) primitives.push_back(unit_box_at(2.0 * i));
+    TreeAssembler assembler(primitives);
+    if (reserved > 0) assembler.reserve(reserved);
+    std::vector<std::uint32_t> level;
+    for (std::uint32_t i = 0; i < count; ++i) level.push_back(assembler.add_leaf(i));
+    std::vector<double> low(count), high(count);
+    for (std::uint32_t i = 0; i < count; ++i) low[i] = 2.0 * i, high[i] = 2.0 * i + 1;
+    while (level.size() > 1) {
+        std::vector<std::uint32_t> next;
+        std::vector<double> next_low, next_high;
+        for (std::size_t i = 0; i < level.size(); i += 2) {
+            if (i + 1 == level.size()) {
+                next.push_back(level[i]), next_low.push_back(low[i]), next_high.push_back(high[i]);
+                continue;
+            }
+            const std::uint32_t pair[] = {level[i], level[i + 1]};
+            next.push_back(assembler.add_group(pair, Aabb{Vec3(low[i], 0, 0), Vec3(high[i + 1], 1, 1)}));
+            next_low.push_back(low[i]), next_high.push_back(high[i + 1]);
+        }
+        level = std::move(next), low = std::move(next_low), high = std::move(next_high);
+    }
+    return std::move(assembler).finish(level.front(), id_of_node);
+}
+
+TEST(TreeAssembler, ReservingChangesNothingButCapacity) {
+    // 30 000 leaves: the items (about 5 MB) and the nodes are past the size at which they go on huge pages.
+    std::vector<std::uint32_t> plain_ids, reserved_ids, short_ids;
+    const Bvh plain = paired_tree(30000, 0, &plain_ids);
+    const Bvh reserved = paired_tree(30000, 60000, &reserved_ids);
+    const Bvh short_reserve = paired_tree(30000, 10, &short_ids);  // too little: the arrays grow as usual
+    ASSERT_TRUE(validate(plain).has_value());
+    ASSERT_EQ(plain.nodes.size(), 59999u);
+    for (const Bvh* other : {&reserved, &short_reserve}) {
+        ASSERT_EQ(other->nodes.size(), plain.nodes.size());
+        for (std::size_t i = 0; i < plain.nodes.size(); ++i) {
+            ASSERT_EQ(other->nodes[i].first_child, plain.nodes[i].first_child) << i;
+            ASSERT_EQ(other->nodes[i].child_count, plain.nodes[i].child_count) << i;
+            ASSERT_EQ(other->nodes[i].primitive, plain.nodes[i].primitive) << i;
+            ASSERT_EQ(std::get<Aabb>(other->nodes[i].volume).min, std::get<Aabb>(plain.nodes[i].volume).min) << i;
+            ASSERT_EQ(std::get<Aabb>(other->nodes[i].volume).max, std::get<Aabb>(plain.nodes[i].volume).max) << i;
+        }
+    }
+    EXPECT_EQ(reserved_ids, plain_ids);
+    EXPECT_EQ(short_ids, plain_ids);
+    EXPECT_EQ(cost(reserved), cost(plain));
+}
+
 TEST(Validate, RejectsABvThatMissesAPrimitive) {
     Bvh bvh = two_pairs();
     bvh.nodes[1].volume = Aabb{Vec3(0, 0, 0), Vec3(2.5, 1, 1)};  // misses the second box's far half
