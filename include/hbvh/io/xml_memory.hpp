@@ -9,7 +9,7 @@ namespace hbvh {
 /// Routes the XML parser's memory (pugixml's DOM, for the survey XML, MJCF and URDF readers alike) to 64 MiB
 /// regions advised for transparent huge pages. A 230 MB survey file builds about 400 MB of DOM in 32 KiB
 /// blocks; in 4 KiB pages that is some 100 000 page faults, and on a virtual machine where a fault costs
-/// ~10 µs they were half of the read (docs/formats.md, "Huge pages for the parser and the writer").
+/// ~10 µs they were two thirds of the read (docs/formats.md, "Huge pages for the parser and the writer").
 ///
 /// pugixml's allocation functions are global to the process, so this is for a program's main(), not for a
 /// library: it replaces whatever functions were set before. Blocks handed out before the call are still
