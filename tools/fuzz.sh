@@ -6,8 +6,8 @@
 # Fails on any crash, leak, timeout, out-of-memory or sanitizer report.
 # Usage: tools/fuzz.sh [seconds] [target...]   explore for N seconds per target (default 20), random seed
 #        tools/fuzz.sh --ci [target...]         what CI runs: a fixed seed and a fixed number of inputs per target,
-#                                               so the same commit always fuzzes the same inputs and a CI failure
-#                                               is reproducible; new bugs are hunted with the timed mode.
+#                                               so every run is as long and a failure's input is kept to replay
+#                                               (docs/reliability.md §3); new bugs are hunted with the timed mode.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 mode=timed
@@ -35,24 +35,30 @@ fi
 export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0${LSAN_OPTIONS:+:$LSAN_OPTIONS}"
 symbolizer="$(command -v llvm-symbolizer || command -v addr2line || true)"
 [ -z "$symbolizer" ] || export ASAN_SYMBOLIZER_PATH="${ASAN_SYMBOLIZER_PATH:-$symbolizer}"
-status=0
-for target in "${targets[@]}"; do
-  fuzzer="build-fuzz/fuzz_$target"
+# One target per core: each fuzzer is single-threaded, and the targets share nothing but the machine (their inputs
+# and logs are per target), so running them side by side halves the phase on two cores without changing what any of
+# them executes. A target's log is printed when it ends, whole, so two targets' lines never interleave.
+jobs="${HBVH_FUZZ_JOBS:-$(nproc)}"
+run_target() {
+  local target="$1"
+  local fuzzer="build-fuzz/fuzz_$target"
   # New inputs go to a scratch copy so the committed seed corpus stays small and reviewed.
-  work="build-fuzz/corpus-$target"
+  local work="build-fuzz/corpus-$target"
+  rm -f "build-fuzz/fuzz_$target.summary"
   mkdir -p "$work" "build-fuzz/artifacts-$target"
-  dict=()
+  local dict=()
   [ -f "fuzz/dict/$target.dict" ] && dict=(-dict="fuzz/dict/$target.dict")
+  local budget limit heading
   if [ "$mode" = ci ]; then
     budget=(-seed=1 -runs="${ci_runs[$target]:-2000}")
     limit=600
     # A fresh scratch corpus, so the run depends on the commit only.
     rm -rf "$work" && mkdir -p "$work"
-    echo "== fuzz_$target: ${ci_runs[$target]:-2000} inputs, seed 1"
+    heading="== fuzz_$target: ${ci_runs[$target]:-2000} inputs, seed 1"
   else
     budget=(-max_total_time="$seconds")
     limit=$((seconds + 60))
-    echo "== fuzz_$target for ${seconds}s"
+    heading="== fuzz_$target for ${seconds}s"
   fi
   # -timeout: one input taking over 10 s is a hang; -rss_limit_mb also caps single allocations (malloc_limit_mb).
   # The outer timeout is a backstop: libFuzzer's own hang report can deadlock in its alarm handler (seen with
@@ -60,11 +66,30 @@ for target in "${targets[@]}"; do
   if ! timeout -k 10 "$limit" "$fuzzer" "${budget[@]}" -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 "${dict[@]}" \
       -artifact_prefix="build-fuzz/artifacts-$target/" "$work" "fuzz/corpus/$target" \
       >"build-fuzz/fuzz_$target.log" 2>&1; then
-    echo "fuzz_$target FAILED: see build-fuzz/fuzz_$target.log and build-fuzz/artifacts-$target/"
-    tail -n 40 "build-fuzz/fuzz_$target.log"
-    status=1
-  else
-    grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/fuzz_$target.log" || true
+    { echo "$heading"
+      echo "fuzz_$target FAILED: see build-fuzz/fuzz_$target.log and build-fuzz/artifacts-$target/"
+      tail -n 40 "build-fuzz/fuzz_$target.log"; } >"build-fuzz/fuzz_$target.summary"
+    return 1
   fi
+  { echo "$heading"
+    grep -E "stat::number_of_executed_units|stat::new_units_added" "build-fuzz/fuzz_$target.log" || true; } \
+    >"build-fuzz/fuzz_$target.summary"
+}
+status=0
+running=0
+for target in "${targets[@]}"; do
+  if [ "$running" -ge "$jobs" ]; then
+    wait -n || status=1
+    running=$((running - 1))
+  fi
+  run_target "$target" &
+  running=$((running + 1))
+done
+while [ "$running" -gt 0 ]; do
+  wait -n || status=1
+  running=$((running - 1))
+done
+for target in "${targets[@]}"; do
+  cat "build-fuzz/fuzz_$target.summary" 2>/dev/null || { echo "fuzz_$target: ended without a summary"; status=1; }
 done
 exit "$status"

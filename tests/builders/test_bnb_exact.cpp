@@ -248,8 +248,15 @@ TEST(BnbExact, EachLevelOptimalAndNoCostlierThanEnlargesOnGeneratedScenes) {
 }
 
 TEST(BnbExact, EachLevelOptimalAndNoCostlierThanEnlargesOnBundledModels) {
+    // The bundled models up to 17 primitives (chair, helicopter, cannon). The tie interceptor's 27 make the same
+    // claims on larger levels, but its two builds were three quarters of this test's 30-39 s under the sanitizers,
+    // and the generated scenes and these three already make every claim (bnb-exact's tree of it is still built and
+    // checked, through `stats`, by the Python suite's test_cost_and_stats_equal_the_cli).
     int compared = 0;
-    for (const auto& [name, primitives] : test_support::bundled_models()) compared += expect_exact_levels(primitives, name);
+    for (const auto& [name, primitives] : test_support::bundled_models()) {
+        if (primitives.size() > 17) continue;
+        compared += expect_exact_levels(primitives, name);
+    }
     EXPECT_GE(compared, 5);
 }
 
