@@ -10,6 +10,7 @@
 #include "guarded_build.hpp"
 #include "report_text.hpp"
 #include "treelet_fit_cache.hpp"
+#include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -25,6 +26,15 @@ struct MemberOutcome {
     BuildReport report;
     TreeletReport treelets;
 };
+
+/// A member's tree. binned's net against split is off: up to its limit split is in the same portfolio, so the
+/// net would only build split's tree a second time.
+Result<Bvh> build_member(std::span<const Primitive> primitives, Algorithm algorithm, const BuildContext& context) {
+    if (algorithm != Algorithm::binned) return build(primitives, algorithm, context);
+    BinnedOptions options;
+    options.guarantee_split_up_to = 0;
+    return build_binned(primitives, context, options);
+}
 
 /// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
 /// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
@@ -50,7 +60,7 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         BuildContext member_context = context;
         member_context.report = context.report != nullptr ? &outcome.report : nullptr;
         member_context.progress = nullptr;  // auto reports per member instead
-        Result<Bvh> built = build(primitives, members[m], member_context);
+        Result<Bvh> built = build_member(primitives, members[m], member_context);
         if (built) {
             outcome.cost = cost(*built, context.policy);
             outcome.costs = std::string(to_string(members[m])) + " " + detail::format_cost(outcome.cost);

@@ -19,6 +19,7 @@
 #include "guarded_build.hpp"
 #include "heuristic_support.hpp"
 #include "../memory/huge_pages.hpp"
+#include "hbvh/builders/split.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "../fit/frames.hpp"
@@ -618,6 +619,18 @@ Result<Bvh> build_binned(std::span<const Primitive> primitives, const BuildConte
         if (twice) {
             Bvh other = binned_internal::BinnedBuilder(set, options, checkpoint, true, 2.0 * n).build(primitives);
             if (cost(other, context.policy) < cost(tree, context.policy)) tree = std::move(other);
+        }
+        if (primitives.size() <= options.guarantee_split_up_to) {
+            // split checks the deadline itself; if it runs out there, binned's tree stands.
+            BuildContext split_context = context;
+            split_context.report = nullptr;
+            split_context.progress = nullptr;
+            Result<Bvh> split = build_split(primitives, split_context);
+            if (split && cost(*split, context.policy) < cost(tree, context.policy)) {
+                tree = std::move(*split);
+                if (context.report != nullptr)
+                    context.report->notes.push_back("binned: split's tree was cheaper and is returned");
+            }
         }
         return tree;
     });

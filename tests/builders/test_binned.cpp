@@ -10,12 +10,15 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "support/test_helpers.hpp"
 #include "hbvh/builders/binned.hpp"
+#include "hbvh/builders/split.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/fit/volume_policy.hpp"
+#include "support/bundled_models.hpp"
 #include "support/tree_properties.hpp"
 
 namespace hbvh {
@@ -27,7 +30,15 @@ using test_support::generated_scene;
 
 VolumePolicy boxes_only() { return parse_allowed_types("aabb").value(); }
 
-Bvh binned(std::span<const Primitive> primitives, const VolumePolicy& policy, BinnedOptions options = {}) {
+/// binned's own tree, without its net against split (which small inputs would otherwise get): these tests are
+/// about its cuts, collapse and fits.
+BinnedOptions own_tree() {
+    BinnedOptions options;
+    options.guarantee_split_up_to = 0;
+    return options;
+}
+
+Bvh binned(std::span<const Primitive> primitives, const VolumePolicy& policy, BinnedOptions options = own_tree()) {
     Result<Bvh> bvh = build_binned(primitives, test_support::context_for(policy), options);
     EXPECT_TRUE(bvh.has_value()) << (bvh ? "" : bvh.error().to_string());
     return bvh ? std::move(bvh).value() : Bvh{};
@@ -73,11 +84,11 @@ TEST(Binned, CollapseIsTheBestOfEverySubsetOfTheBinaryTree) {
         for (const std::uint32_t max_children : {3u, 4u, 8u}) {
             const std::vector<Primitive> primitives = generated_scene(12 + seed % 3, 70 + seed, seed % 2 == 0);
             SCOPED_TRACE("seed " + std::to_string(seed) + ", max_children " + std::to_string(max_children));
-            BinnedOptions binary_options;
+            BinnedOptions binary_options = own_tree();
             binary_options.max_children = 2;
             const Bvh binary = binned(primitives, boxes_only(), binary_options);
             for (const Node& node : binary.nodes) ASSERT_TRUE(node.is_leaf() || node.child_count == 2);
-            BinnedOptions wide_options;
+            BinnedOptions wide_options = own_tree();
             wide_options.max_children = max_children;
             const Bvh wide = binned(primitives, boxes_only(), wide_options);
             expect_tree_properties(primitives, wide);
@@ -104,7 +115,7 @@ TEST(Binned, PropertiesOnGeneratedScenesEveryPolicy) {
         for (const std::uint32_t count : {1u, 2u, 3u, 17u, 300u, 2500u}) {
             SCOPED_TRACE(std::string(types) + " " + std::to_string(count));
             const std::vector<Primitive> primitives = generated_scene(count, 5 + count, count % 2 == 0);
-            BinnedOptions options;
+            BinnedOptions options = own_tree();
             options.hull_fit_min_primitives = 64;  // so that 2500 primitives reach both kinds of hull fit
             options.hull_fit_max_primitives = 512;
             options.exact_fit_max_primitives = 2;
@@ -131,6 +142,34 @@ TEST(Binned, DepthStaysLogarithmicOnAChainOfScales) {
         for (std::uint32_t c = 0; c < bvh.nodes[i].child_count; ++c) depth[bvh.nodes[i].first_child + c] = depth[i] + 1;
     }
     EXPECT_LE(height, bound);
+}
+
+// Up to guarantee_split_up_to primitives the result is the cheaper of binned's own tree and split's, and beyond it
+// binned's own. The tie interceptor is a model where split's tree is the cheaper (docs/scale.md §9), so both
+// branches are taken.
+TEST(Binned, NeverCostlierThanSplitUpToItsLimit) {
+    std::vector<std::pair<std::string, std::vector<Primitive>>> inputs = test_support::bundled_models();
+    for (const std::uint32_t count : {5u, 30u, 64u, 65u})
+        inputs.emplace_back("generated " + std::to_string(count), generated_scene(count, count));
+    const std::uint32_t limit = BinnedOptions{}.guarantee_split_up_to;
+    int split_kept = 0, own_kept = 0;
+    for (const auto& [name, primitives] : inputs) {
+        SCOPED_TRACE(name);
+        const VolumePolicy policy = VolumePolicy::all();
+        const Bvh netted = binned(primitives, policy, BinnedOptions{});
+        const Bvh own = binned(primitives, policy);
+        expect_tree_properties(primitives, netted);
+        if (primitives.size() > limit) {
+            EXPECT_EQ(cost(netted), cost(own));
+            continue;
+        }
+        const Result<Bvh> split = build_split(primitives, test_support::context_for(policy));
+        ASSERT_TRUE(split.has_value());
+        EXPECT_EQ(cost(netted), std::min(cost(own), cost(*split)));
+        (cost(*split) < cost(own) ? split_kept : own_kept) += 1;
+    }
+    EXPECT_GT(split_kept, 0);
+    EXPECT_GT(own_kept, 0);
 }
 
 TEST(Binned, CoincidentAndFlatScenes) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "support/test_helpers.hpp"
+#include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/builders/scale.hpp"
 #include "hbvh/builders/treelet.hpp"
@@ -143,13 +144,28 @@ TEST(Auto, SameTreeForOneAndTwoThreadsAndAsTheMembersAlone) {
         };
         const Bvh two = build_with(2);
         test_support::expect_identical_trees(build_with(1), two);
-        // The cheapest member refined alone, the first on ties, as a serial loop would find it.
+        // The cheapest member refined alone, the first on ties, as a serial loop would find it (binned without its
+        // net against split, as auto builds it).
         std::optional<Bvh> cheapest;
+        BinnedOptions binned_alone;
+        binned_alone.guarantee_split_up_to = 0;
         for (const Algorithm member : auto_portfolio(count)) {
-            const Bvh refined = refine_treelets(build(primitives, member, BuildContext{}).value(), VolumePolicy::all());
+            const Bvh built = member == Algorithm::binned ? build_binned(primitives, BuildContext{}, binned_alone).value()
+                                                          : build(primitives, member, BuildContext{}).value();
+            const Bvh refined = refine_treelets(built, VolumePolicy::all());
             if (!cheapest || cost(refined) < cost(*cheapest)) cheapest = refined;
         }
         test_support::expect_identical_trees(*cheapest, two);
+    }
+}
+
+// auto builds its binned member without binned's net against split, because split is in the same portfolio
+// wherever the net would run.
+TEST(Auto, SplitIsInEveryPortfolioWhereBinnedWouldBuildIt) {
+    for (std::uint32_t count = 1; count <= BinnedOptions{}.guarantee_split_up_to; ++count) {
+        const std::vector<Algorithm> members = auto_portfolio(count);
+        if (std::find(members.begin(), members.end(), Algorithm::binned) == members.end()) continue;
+        EXPECT_NE(std::find(members.begin(), members.end(), Algorithm::split), members.end()) << count;
     }
 }
 

@@ -42,6 +42,11 @@ struct BinnedOptions {
     std::uint32_t exact_fit_max_primitives = 0;
     /// Inputs of at most this many primitives have every kept node refitted with fit_best as well.
     std::uint32_t exact_fit_all_up_to = 1000;
+    /// Inputs of at most this many primitives also get split's tree (its default options), and the cheaper one
+    /// (Eq. 2) is returned, so that binned is never costlier than split where split takes milliseconds: on small
+    /// objects binned's box-priced cuts lost to split's by 0.3-1.3 % on two of 24 models (docs/scale.md §9).
+    /// 0: binned's own tree always. `auto` turns it off for its binned member: its portfolio has split already.
+    std::uint32_t guarantee_split_up_to = 64;
 };
 
 /// A hierarchy for large scenes (10^4 to 10^6 primitives and more), in O(n log n) and on every core:
@@ -52,7 +57,8 @@ struct BinnedOptions {
 /// 2. each binary node's volume: the cheapest allowed kind of its cheap fit over the generating spheres below;
 /// 3. the collapse: the subset of binary nodes to keep that minimises Eq. 2 exactly, by dynamic programming
 ///    over the binary tree with at most `max_children` children per kept node;
-/// 4. the kept nodes' volumes, refitted with fit_best where small.
+/// 4. the kept nodes' volumes, refitted with fit_best where small;
+/// 5. up to `guarantee_split_up_to` primitives, split's tree instead where that is cheaper.
 /// Deterministic for any thread count (each range is cut by one task, from its contents only).
 /// Deadline: checked at every range; progress: the share of primitives placed.
 [[nodiscard]] Result<Bvh> build_binned(std::span<const Primitive> primitives, const BuildContext& context,
