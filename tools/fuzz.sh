@@ -36,8 +36,8 @@ export LSAN_OPTIONS="suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0${LSAN
 symbolizer="$(command -v llvm-symbolizer || command -v addr2line || true)"
 [ -z "$symbolizer" ] || export ASAN_SYMBOLIZER_PATH="${ASAN_SYMBOLIZER_PATH:-$symbolizer}"
 # One target per core: each fuzzer is single-threaded, and the targets share nothing but the machine (their inputs
-# and logs are per target), so running them side by side halves the phase on two cores without changing what any of
-# them executes. A target's log is printed when it ends, whole, so two targets' lines never interleave.
+# and logs are per target), so running them side by side halves the phase on two cores; each still runs its fixed
+# seed and count. The summaries are printed once all have ended, in the targets' order, so no lines interleave.
 jobs="${HBVH_FUZZ_JOBS:-$(nproc)}"
 run_target() {
   local target="$1"

@@ -21,7 +21,8 @@ namespace hbvh {
 namespace {
 
 /// binned without its three slow steps for small inputs: the per-side fits of its cuts (estimate sweeps),
-/// fit_best on every kept node and split's tree beside its own. What is left is the box-priced cuts, the collapse and one cheap fit a node.
+/// fit_best on every kept node and split's tree beside its own. What is left is the box-priced cuts, the
+/// collapse and one cheap fit a node.
 /// Where the treelet sweep follows, no node gets more children than a treelet has units: a wider node's
 /// children could never be re-grouped (on the duplo brick, an 8-child node kept the tree at 1.11x auto's cost;
 /// at most 5 children, 1.05x; no other object of docs/fast.md changed).
