@@ -520,7 +520,7 @@ fi
 # 7. Which cost predicts query time.
 if wanted 7; then
     emit "## 7. Which cost predicts query time" ""
-    log "section 7: hbvh_objectives (10-15 min)"
+    log "section 7: hbvh_objectives (under a minute on the 2-core machine of 2026-12-03)"
     emit "Every registered builder's tree of each object, built for Eq. 2 and for the calibrated objective" \
          "(\`NAME/cal\`: Minkowski measure and measured per-kind weights, docs/metrics.md \"Calibrated cost\"), timed on the same 300 recorded queries of the" \
          "survey's simulator per phase (\`first\` mode; the mover's path recorded once with the Two-Level query, so" \
