@@ -305,8 +305,6 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
 
 // Stage 3: files, as the CLI reads them (read_model_file; then the CLI's load_model checks).
 
-int line_of(const Hierarchy& h, std::uint32_t node) { return node < h.node_lines.size() ? h.node_lines[node] : 0; }
-
 /// Primitives or a Hierarchy from any file the CLI reads. `format` as the CLI's --format.
 py::object load(const std::string& path, const std::string& format, bool refit) {
     Result<ModelFile> read = read_model_file(path, format);
@@ -360,7 +358,7 @@ py::dict stats_dict(const Hierarchy& h) {
     for (BvType type : all_bv_types) types[py::str(std::string(to_string(type)))] = stats.types[static_cast<std::size_t>(type)];
     py::list violations;
     for (const ContainmentViolation& v : containment_violations(h.bvh))
-        violations.append(py::dict("node"_a = v.node, "line"_a = line_of(h, v.node),
+        violations.append(py::dict("node"_a = v.node, "line"_a = line_of_node(h.node_lines, v.node),
                                    "type"_a = std::string(to_string(type_of(h.bvh.nodes[v.node].volume))),
                                    "primitive"_a = v.primitive, "name"_a = h.bvh.primitives[v.primitive].name,
                                    "by"_a = v.protrusion, "message"_a = describe_violation(h.bvh, v)));

@@ -105,6 +105,10 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
     return from_import(import_primitives(path, chosen->second), path);
 }
 
+int line_of_node(std::span<const int> node_lines, std::uint32_t node) {
+    return node < node_lines.size() ? node_lines[node] : 0;
+}
+
 Status check_model_file(const ModelFile& model, const std::string& source) {
     if (Status valid = validate_primitives(model.primitives); !valid) return Error{valid.error().message, source};
     if (Status finite = check_finite_extent(model.primitives); !finite) return Error{finite.error().message, source};
@@ -122,8 +126,8 @@ Result<Bvh> enclosing_hierarchy(Bvh stored, std::span<const int> node_lines, con
         const ContainmentViolation& first = violations.front();
         std::string message = describe_violation(stored, first);
         if (violations.size() > 1) message += " (and " + std::to_string(violations.size() - 1) + " more volumes)";
-        const int line = first.node < node_lines.size() ? node_lines[first.node] : 0;
-        return Error{message + "; " + std::string(refit_option) + " refits them", source, line};
+        return Error{message + "; " + std::string(refit_option) + " refits them", source,
+                     line_of_node(node_lines, first.node)};
     }
     const std::size_t count = refit_non_enclosing(stored);
     if (Status valid = validate(stored); !valid)

@@ -92,7 +92,5 @@ struct BuilderFlags {
 /// Ok when the model has no stored hierarchy or its volumes enclose their primitives (or flags.refit, after
 /// a note); for build, which rebuilds from the primitives but must not pass over a broken file in silence.
 [[nodiscard]] Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags);
-/// The line of node `node` in the model's file, 0 when unknown.
-[[nodiscard]] int line_of_node(const Model& model, std::uint32_t node);
 
 }  // namespace hbvh::cli

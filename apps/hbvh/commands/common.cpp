@@ -133,10 +133,6 @@ void BuilderFlags::add_refit_to(CLI::App& command) {
                      "refitted, same BV kind, tree kept) instead of refused");
 }
 
-int line_of_node(const Model& model, std::uint32_t node) {
-    return node < model.node_lines.size() ? model.node_lines[node] : 0;
-}
-
 namespace {
 /// The stored hierarchy if every volume encloses its primitives; with --refit, repaired; else the Error
 /// naming the first bad volume's line.

@@ -58,7 +58,7 @@ nlohmann::ordered_json violations_json(const Model& model, const Bvh& bvh,
     nlohmann::ordered_json out = nlohmann::ordered_json::array();
     for (const ContainmentViolation& v : violations)
         out.push_back({{"node", v.node},
-                       {"line", line_of_node(model, v.node)},
+                       {"line", line_of_node(model.node_lines, v.node)},
                        {"type", to_string(type_of(bvh.nodes[v.node].volume))},
                        {"primitive", v.primitive},
                        {"name", bvh.primitives[v.primitive].name},
@@ -88,7 +88,7 @@ int run_stats(const StatsArguments& args) {
             fmt::print("{:<12} {} volumes do not enclose their primitives (--refit on other commands repairs them)\n",
                        "violations", violations.size());
             for (const ContainmentViolation& v : violations)
-                fmt::print("  {}:{}: {}\n", model->source, line_of_node(model.value(), v.node),
+                fmt::print("  {}:{}: {}\n", model->source, line_of_node(model->node_lines, v.node),
                            describe_violation(bvh.value(), v));
         }
     }

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <span>
 #include <string>
@@ -24,6 +25,10 @@ struct ModelFile {
     std::vector<std::string> warnings;
     std::vector<int> node_lines;  ///< XmlModel::node_lines; empty for other formats.
 };
+
+/// The line of stored node `node` in its file, from ModelFile::node_lines; 0 when unknown (a binary file, a node
+/// past the list).
+[[nodiscard]] int line_of_node(std::span<const int> node_lines, std::uint32_t node);
 
 /// Reads `path` as `format` says: "" decides by the name and the content (.hbvh, or bytes that start with
 /// binary_magic: the binary format; .xml: MJCF when its root is <mujoco>, else the survey format; .urdf; the mesh
