@@ -11,6 +11,7 @@
 #include <hbvh/result.hpp>
 
 // hbvh::core
+#include <hbvh/files.hpp>
 #include <hbvh/geometry/vector.hpp>
 #include <hbvh/geometry/aabb.hpp>
 #include <hbvh/geometry/obb.hpp>

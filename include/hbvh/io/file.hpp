@@ -1,25 +1,14 @@
 // SPDX-License-Identifier: MIT
-// Whole-file reading, and writing that never leaves a partial output behind.
+// Files as hbvh::io sees them: read_text_file and write_file_atomic (from the core library's hbvh/files.hpp,
+// included here so that code including this header keeps compiling), and formats chosen by extension.
 #pragma once
 
 #include <filesystem>
 #include <string>
-#include <string_view>
 
-#include "hbvh/result.hpp"
+#include "hbvh/files.hpp"
 
 namespace hbvh {
-
-/// The bytes of the file at `path`, unchanged. A missing, unreadable or directory path gives an Error
-/// whose `file` is `path` and whose message says why (from the operating system).
-[[nodiscard]] Result<std::string> read_text_file(const std::filesystem::path& path);
-
-/// Replaces the file at `path` with `content` atomically: the content goes to a new temporary file in
-/// the same directory, is flushed to disk (fsync), and is then renamed over `path`. Readers therefore
-/// see either the old file or the complete new one. On any failure the temporary file is removed and
-/// `path` is left as it was. An existing file's permission bits are kept; a new file gets the usual
-/// 0666 & ~umask. A symbolic link at `path` is replaced by the file, not followed. POSIX only.
-[[nodiscard]] Status write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
 /// The extension of `path` with its dot, in ASCII lower case (".ply" for "Mesh.PLY"); empty when it has none.
 /// Formats are chosen by extension case-insensitively, as assimp chooses its readers.

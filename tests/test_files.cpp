@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// read_text_file and write_file_atomic: contents, errors that name the file, nothing left behind.
-#include "hbvh/io/file.hpp"
+// read_text_file and write_file_atomic (hbvh/files.hpp, core): contents, errors that name the file, nothing left behind.
+#include "hbvh/files.hpp"
 
 #include <gtest/gtest.h>
 #include <sys/stat.h>

@@ -1,0 +1,159 @@
+// SPDX-License-Identifier: MIT
+// read_text_file and write_file_atomic on POSIX file descriptors, so every failure has its errno.
+#include "hbvh/files.hpp"
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <chrono>
+#include <system_error>
+
+#include "memory/huge_pages.hpp"
+
+namespace hbvh {
+namespace {
+
+/// The operating system's words for `code` (std::generic_category is thread-safe, strerror is not).
+std::string describe(int code) { return std::generic_category().message(code); }
+
+/// Closes `fd` on scope exit unless released, so early returns cannot leak descriptors.
+class FileDescriptor {
+public:
+    explicit FileDescriptor(int fd) : fd_(fd) {}
+    FileDescriptor(const FileDescriptor&) = delete;
+    FileDescriptor& operator=(const FileDescriptor&) = delete;
+    ~FileDescriptor() {
+        if (fd_ >= 0) ::close(fd_);
+    }
+    [[nodiscard]] int get() const { return fd_; }
+    /// Closes now and reports close()'s own error: on some file systems that is where a failed write shows.
+    int close_checked() {
+        const int fd = fd_;
+        fd_ = -1;
+        return ::close(fd) == 0 ? 0 : errno;
+    }
+
+private:
+    int fd_;
+};
+
+/// Writes all of `data`, resuming after partial writes and signals. Returns 0 or an errno value.
+int write_all(int fd, std::string_view data) {
+    while (!data.empty()) {
+        const ssize_t written = ::write(fd, data.data(), data.size());
+        if (written < 0) {
+            if (errno == EINTR) continue;
+            return errno;
+        }
+        data.remove_prefix(static_cast<std::size_t>(written));
+    }
+    return 0;
+}
+
+/// One read(), resumed after signals: the byte count, 0 at the end of the file, or -1 with errno set.
+ssize_t read_some(int fd, char* data, std::size_t size) {
+    for (;;) {
+        const ssize_t count = ::read(fd, data, size);
+        if (count >= 0 || errno != EINTR) return count;
+    }
+}
+
+/// A name for the temporary file that no other writer (thread or process) picks at the same time.
+/// Hidden (leading dot) so directory listings and globs don't catch a half-written file.
+std::filesystem::path temporary_name(const std::filesystem::path& target, unsigned attempt) {
+    static std::atomic<unsigned> counter{0};
+    const auto ticks = static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count());
+    // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on the chain of operator+ this was.
+    std::string name(1, '.');
+    for (const std::string& part : {target.filename().string(), std::string(".tmp-"), std::to_string(::getpid()),
+                                    std::string(1, '-'), std::to_string(counter.fetch_add(1)), std::string(1, '-'),
+                                    std::to_string(ticks % 1000000007ULL), std::string(1, '-'), std::to_string(attempt)})
+        name += part;
+    return target.parent_path() / name;
+}
+
+}  // namespace
+
+Result<std::string> read_text_file(const std::filesystem::path& path) {
+    const std::string name = path.string();
+    int fd = -1;
+    do {
+        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    } while (fd < 0 && errno == EINTR);
+    if (fd < 0) return Error("cannot open for reading: " + describe(errno), name);
+    FileDescriptor file(fd);
+
+    // A directory opens fine on Linux and fails only at read(); say so plainly instead.
+    struct stat info {};
+    if (::fstat(file.get(), &info) == 0 && S_ISDIR(info.st_mode)) return Error("is a directory, not a file", name);
+
+    // A regular file is read straight into a string of its size: growing a string chunk by chunk would copy
+    // a large file several times over.
+    std::string content;
+    if (S_ISREG(info.st_mode) && info.st_size > 0)
+        detail::resize_on_huge_pages(content, static_cast<std::size_t>(info.st_size));
+    std::size_t filled = 0;
+    while (filled < content.size()) {
+        const ssize_t count = read_some(file.get(), content.data() + filled, content.size() - filled);
+        if (count < 0) return Error("cannot read: " + describe(errno), name);
+        if (count == 0) break;  // the file shrank meanwhile
+        filled += static_cast<std::size_t>(count);
+    }
+    content.resize(filled);
+    // Then on to the end: the file may have grown, and pipes and /proc files report no size.
+    char chunk[65536];
+    for (;;) {
+        const ssize_t count = read_some(file.get(), chunk, sizeof chunk);
+        if (count < 0) return Error("cannot read: " + describe(errno), name);
+        if (count == 0) break;
+        content.append(chunk, static_cast<std::size_t>(count));
+    }
+    return content;
+}
+
+Status write_file_atomic(const std::filesystem::path& path, std::string_view content) {
+    const std::string name = path.string();
+    if (path.empty() || !path.has_filename()) return Error("not a file name", name);
+
+    // Stage 1: create a fresh temporary file next to the target. Same directory means same file system,
+    // which rename() needs to be atomic. O_EXCL guarantees we never write into someone else's file.
+    std::filesystem::path temporary;
+    int fd = -1;
+    for (unsigned attempt = 0; attempt < 100 && fd < 0; ++attempt) {
+        temporary = temporary_name(path, attempt);
+        fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0 && errno != EEXIST && errno != EINTR) break;
+    }
+    if (fd < 0) return Error("cannot create a temporary file next to it: " + describe(errno), name);
+    FileDescriptor file(fd);
+    auto fail = [&](std::string what, int code) -> Status {
+        ::unlink(temporary.c_str());
+        return Error(std::move(what) + ": " + describe(code), name);
+    };
+
+    // Stage 2: keep an existing file's permissions (e.g. a group-writable output), then write and flush.
+    struct stat existing {};
+    if (::stat(path.c_str(), &existing) == 0 && S_ISREG(existing.st_mode))
+        ::fchmod(file.get(), existing.st_mode & 07777);
+    if (const int code = write_all(file.get(), content); code != 0) return fail("cannot write", code);
+    if (::fsync(file.get()) != 0) return fail("cannot flush to disk", errno);
+    if (const int code = file.close_checked(); code != 0) return fail("cannot write", code);
+
+    // Stage 3: publish. rename() replaces the target in one step; after it the content is in place.
+    if (::rename(temporary.c_str(), path.c_str()) != 0) return fail("cannot replace the file", errno);
+
+    // Make the rename itself durable. Best effort: the file is already complete and in place, and some
+    // file systems refuse fsync on directories, so a failure here is not an error.
+    const std::filesystem::path directory = path.parent_path().empty() ? "." : path.parent_path();
+    const int directory_fd = ::open(directory.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (directory_fd >= 0) {
+        ::fsync(directory_fd);
+        ::close(directory_fd);
+    }
+    return Ok{};
+}
+
+}  // namespace hbvh
