@@ -130,13 +130,13 @@ void register_all() {
         for (const CollideMode mode : {CollideMode::all, CollideMode::first}) {
             const std::string suffix = "/" + std::to_string(count) + (mode == CollideMode::all ? "/all" : "/first");
             for (const AlgorithmInfo& info : algorithms()) {
-                const Algorithm algorithm = info.algorithm;
+                const Algorithm algorithm = info.algorithm();
                 benchmark::RegisterBenchmark(("tandem/" + std::string(info.name) + suffix).c_str(),
                                              [count, algorithm, mode](benchmark::State& state) {
                                                  run_queries<false>(state, scenario_for(count, algorithm), mode);
                                              });
             }
-            const Algorithm baseline_tree = algorithms().front().algorithm;
+            const Algorithm baseline_tree = algorithms().front().algorithm();
             benchmark::RegisterBenchmark(("two_level_query" + suffix).c_str(),
                                          [count, baseline_tree, mode](benchmark::State& state) {
                                              run_queries<true>(state, scenario_for(count, baseline_tree), mode);

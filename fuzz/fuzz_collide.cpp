@@ -191,23 +191,19 @@ hbvh::VolumePolicy read_policy(std::uint8_t code) {
 /// primitive, and the survey's B&B and bnb-exact search many candidate groups per level.
 std::size_t size_limit(hbvh::Algorithm algorithm, bool fits_are_costly) {
     using hbvh::Algorithm;
-    switch (algorithm) {
-        case Algorithm::two_level: return max_primitives;
-        case Algorithm::merge:
-        case Algorithm::obb_tree: return fits_are_costly ? 14 : max_primitives;
-        case Algorithm::insertion:
-        case Algorithm::split:
-        case Algorithm::fast: return fits_are_costly ? 10 : max_primitives;
-        case Algorithm::scale:
-        case Algorithm::binned: return fits_are_costly ? 5 : 16;  // binned builds small inputs twice, fit_best per node
-        case Algorithm::insertion_haber: return fits_are_costly ? 4 : max_primitives;
-        case Algorithm::bnb_enlarge: return fits_are_costly ? 4 : 10;
-        case Algorithm::bnb_tightest:
-        case Algorithm::bnb_exact: return fits_are_costly ? 3 : 8;
-        case Algorithm::optimal:
-        case Algorithm::automatic: return fits_are_costly ? 4 : 8;
-    }
-    return 1;
+    const auto is = [&](std::initializer_list<Algorithm> these) {
+        return std::find(these.begin(), these.end(), algorithm) != these.end();
+    };
+    if (is({Algorithm::two_level})) return max_primitives;
+    if (is({Algorithm::merge, Algorithm::obb_tree})) return fits_are_costly ? 14 : max_primitives;
+    if (is({Algorithm::insertion, Algorithm::split, Algorithm::fast})) return fits_are_costly ? 10 : max_primitives;
+    if (is({Algorithm::scale, Algorithm::binned}))
+        return fits_are_costly ? 5 : 16;  // binned builds small inputs twice, fit_best per node
+    if (is({Algorithm::insertion_haber})) return fits_are_costly ? 4 : max_primitives;
+    if (is({Algorithm::bnb_enlarge})) return fits_are_costly ? 4 : 10;
+    if (is({Algorithm::bnb_tightest, Algorithm::bnb_exact})) return fits_are_costly ? 3 : 8;
+    if (is({Algorithm::optimal, Algorithm::automatic})) return fits_are_costly ? 4 : 8;
+    return 3;  // a builder added since: as small as the exponential ones until it is timed
 }
 
 void print_volume(const BoundingVolume& bv) {
@@ -345,7 +341,7 @@ std::optional<Built> build_checked(const std::vector<Primitive>& primitives, con
     hbvh::BuildContext options;
     options.policy = policy;
     const auto start = std::chrono::steady_clock::now();
-    hbvh::Result<hbvh::Bvh> bvh = hbvh::build(primitives, info.algorithm, options);
+    hbvh::Result<hbvh::Bvh> bvh = hbvh::build(primitives, info.algorithm(), options);
     if (timing)
         std::fprintf(stderr, "fuzz_collide: %zu primitives, %.*s: %.1f ms\n", primitives.size(),
                      static_cast<int>(info.name.size()), info.name.data(),
@@ -382,8 +378,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const hbvh::AlgorithmInfo& builder_a = registry[in.byte() % registry.size()];
     const hbvh::AlgorithmInfo& builder_b = same_set && (flags >> 2) & 1 ? builder_a
                                                                         : registry[in.byte() % registry.size()];
-    const std::size_t limit_a = size_limit(builder_a.algorithm, fits_are_costly);
-    const std::size_t limit_b = size_limit(builder_b.algorithm, fits_are_costly);
+    const std::size_t limit_a = size_limit(builder_a.algorithm(), fits_are_costly);
+    const std::size_t limit_b = size_limit(builder_b.algorithm(), fits_are_costly);
 
     const std::vector<Primitive> a = read_primitives(in, scale, same_set ? std::min(limit_a, limit_b) : limit_a);
     const std::vector<Primitive> b_own = same_set ? std::vector<Primitive>{} : read_primitives(in, scale, limit_b);

@@ -125,7 +125,7 @@ struct Options {
 Algorithm pick_algorithm() {
     for (std::string_view name : {"auto", "bnb-enlarge", "two-level"})
         if (auto algorithm = parse_algorithm(name)) return *algorithm;
-    return algorithms().front().algorithm;
+    return algorithms().front().algorithm();
 }
 
 /// Fixed seeded poses of copy b for one regime. partial: random rotation and offset with the root BVs

@@ -19,22 +19,23 @@ Result<Bvh> with_defaults(std::span<const Primitive> primitives, const BuildCont
     return builder(primitives, context, {});
 }
 
-// The one table: a new builder is one row here (and its enum value).
+// The one table: a new builder is one row here. (The Algorithm constants in registry.hpp name the rows by
+// their names; a builder needs none to be built, listed, tested and compared.)
 constexpr std::array registry{
-    AlgorithmInfo{Algorithm::two_level, "two-level", "the survey's baseline: one root BV (best allowed type) over all primitives", with_defaults<build_two_level>},
-    AlgorithmInfo{Algorithm::bnb_tightest, "bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound", with_defaults<build_bnb_tightest>},
-    AlgorithmInfo{Algorithm::bnb_enlarge, "bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound", with_defaults<build_bnb_enlarge>},
-    AlgorithmInfo{Algorithm::bnb_exact, "bnb-exact", "bottom-up levels, Tightest+Enlarge+kNN candidates, exact set partition; never worse than bnb-enlarge", with_defaults<build_bnb_exact>},
-    AlgorithmInfo{Algorithm::optimal, "optimal", "globally optimal Eq. 2 hierarchy by subset DP; at most 18 primitives by default", with_defaults<build_optimal>},
-    AlgorithmInfo{Algorithm::merge, "merge", "OpenTissue bottom-up merge: collapse cheapest edges of an enlarged-overlap graph (survey 2.3)", with_defaults<build_merge>},
-    AlgorithmInfo{Algorithm::insertion, "insertion", "Goldsmith-Salmon incremental insertion in input order (survey 2.1)", with_defaults<build_insertion>},
-    AlgorithmInfo{Algorithm::insertion_haber, "insertion-haber", "insertion with Haber et al.'s extra rule, re-insertion and ill-formed-group elimination (survey 2.1)", with_defaults<build_insertion_haber>},
-    AlgorithmInfo{Algorithm::split, "split", "Mueller et al. top-down split at the cheapest sorted cut on x, y or z (survey 2.2)", with_defaults<build_split>},
-    AlgorithmInfo{Algorithm::obb_tree, "obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)", with_defaults<build_obbtree>},
-    AlgorithmInfo{Algorithm::scale, "scale", "10^3-10^6 primitives: bottom-up levels, kNN candidates, exact partition per Morton window, multi-threaded (docs/scale.md)", with_defaults<build_scale>},
-    AlgorithmInfo{Algorithm::binned, "binned", "10^4-10^6+ primitives: top-down binned volume splits, then the Eq. 2-optimal collapse into wide nodes (docs/scale.md 9)", with_defaults<build_binned>},
-    AlgorithmInfo{Algorithm::fast, "fast", "the speed preset (--quality fast): binned's tree with cheap fits, treelets priced by cheap fits, fit_best on the heaviest nodes; about a millisecond for a few dozen primitives", with_defaults<build_fast>},
-    AlgorithmInfo{Algorithm::automatic, "auto", "by size: optimal up to 10 primitives; above, the cheapest of a portfolio of builders, then treelet refinement (docs/treelets.md)", with_defaults<build_auto>},
+    AlgorithmInfo{"two-level", "the survey's baseline: one root BV (best allowed type) over all primitives", with_defaults<build_two_level>},
+    AlgorithmInfo{"bnb-tightest", "the survey's B&B-Tightest: per level, Eq. 1 tightest-growth candidates + branch and bound", with_defaults<build_bnb_tightest>},
+    AlgorithmInfo{"bnb-enlarge", "the survey's B&B-Enlarge: per level, 5 % enlargement candidates + branch and bound", with_defaults<build_bnb_enlarge>},
+    AlgorithmInfo{"bnb-exact", "bottom-up levels, Tightest+Enlarge+kNN candidates, exact set partition; never worse than bnb-enlarge", with_defaults<build_bnb_exact>},
+    AlgorithmInfo{"optimal", "globally optimal Eq. 2 hierarchy by subset DP; at most 18 primitives by default", with_defaults<build_optimal>},
+    AlgorithmInfo{"merge", "OpenTissue bottom-up merge: collapse cheapest edges of an enlarged-overlap graph (survey 2.3)", with_defaults<build_merge>},
+    AlgorithmInfo{"insertion", "Goldsmith-Salmon incremental insertion in input order (survey 2.1)", with_defaults<build_insertion>},
+    AlgorithmInfo{"insertion-haber", "insertion with Haber et al.'s extra rule, re-insertion and ill-formed-group elimination (survey 2.1)", with_defaults<build_insertion_haber>},
+    AlgorithmInfo{"split", "Mueller et al. top-down split at the cheapest sorted cut on x, y or z (survey 2.2)", with_defaults<build_split>},
+    AlgorithmInfo{"obbtree", "Gottschalk OBB-tree: split at the mean centre along the covariance OBB's longest axis (survey 2.2)", with_defaults<build_obbtree>},
+    AlgorithmInfo{"scale", "10^3-10^6 primitives: bottom-up levels, kNN candidates, exact partition per Morton window, multi-threaded (docs/scale.md)", with_defaults<build_scale>},
+    AlgorithmInfo{"binned", "10^4-10^6+ primitives: top-down binned volume splits, then the Eq. 2-optimal collapse into wide nodes (docs/scale.md 9)", with_defaults<build_binned>},
+    AlgorithmInfo{"fast", "the speed preset (--quality fast): binned's tree with cheap fits, treelets priced by cheap fits, fit_best on the heaviest nodes; about a millisecond for a few dozen primitives", with_defaults<build_fast>},
+    AlgorithmInfo{"auto", "by size: optimal up to 10 primitives; above, the cheapest of a portfolio of builders, then treelet refinement (docs/treelets.md)", with_defaults<build_auto>},
 };
 }  // namespace
 
@@ -42,18 +43,16 @@ std::span<const AlgorithmInfo> algorithms() { return registry; }
 
 const AlgorithmInfo& algorithm_info(Algorithm algorithm) {
     for (const AlgorithmInfo& row : registry)
-        if (row.algorithm == algorithm) return row;
-    HBVH_ASSERT(false && "every Algorithm has a registry row");
+        if (row.name == algorithm.name()) return row;
+    HBVH_ASSERT(false && "every Algorithm names a registry row");
     return registry.front();
 }
 
 std::optional<Algorithm> parse_algorithm(std::string_view name) {
     for (const AlgorithmInfo& row : registry)
-        if (row.name == name) return row.algorithm;
+        if (row.name == name) return row.algorithm();
     return std::nullopt;
 }
-
-std::string_view to_string(Algorithm algorithm) { return algorithm_info(algorithm).name; }
 
 namespace {
 std::string range_message(const Vec3& extent, const char* problem) {

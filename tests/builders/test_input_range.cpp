@@ -27,7 +27,7 @@ TEST(InputRange, OverflowIsRefusedWithAMessage) {
     EXPECT_NE(checked.error().message.find("overflow"), std::string::npos);
     // Every builder refuses, the exact ones included (optimal used to run for minutes on such input).
     for (const AlgorithmInfo& info : algorithms())
-        EXPECT_FALSE(build(two_spheres(1e120), info.algorithm).has_value()) << info.name;
+        EXPECT_FALSE(build(two_spheres(1e120), info.algorithm()).has_value()) << info.name;
 }
 
 TEST(InputRange, UnderflowIsRefusedButAFlatModelIsNot) {

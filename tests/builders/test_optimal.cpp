@@ -151,7 +151,7 @@ TEST(OptimalHierarchy, NoWorseThanAnyRegisteredBuilder) {
         ASSERT_TRUE(optimal.has_value());
         const double optimal_cost = tree_cost(*optimal, options.policy);
         for (const AlgorithmInfo& info : algorithms()) {
-            const Result<Bvh> other = build(primitives, info.algorithm, options);
+            const Result<Bvh> other = build(primitives, info.algorithm(), options);
             if (!other.has_value()) continue;
             EXPECT_LE(optimal_cost, tree_cost(*other, options.policy) * (1.0 + 1e-9)) << info.name << " seed " << seed;
         }

@@ -128,7 +128,7 @@ TEST(Build, RefusesBadGeometryNamingThePrimitive) {
     std::vector<Primitive> primitives = good_primitives();
     primitives[2] = {Sphere{Vec3(0, 0, 0), -1.0}, "negative"};
     for (const AlgorithmInfo& info : algorithms()) {
-        const Result<Bvh> built = build(primitives, info.algorithm);
+        const Result<Bvh> built = build(primitives, info.algorithm());
         ASSERT_FALSE(built) << info.name;
         EXPECT_NE(built.error().message.find("primitive 2 ('negative')"), std::string::npos) << built.error().message;
     }

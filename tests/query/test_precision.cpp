@@ -28,13 +28,9 @@ using Pairs = std::vector<std::pair<std::uint32_t, std::uint32_t>>;
 /// bnb-exact 0.1-0.12 s and bnb-tightest 75-90 ms, which get 8: 20-50 ms). Each test builds 40 trees per
 /// builder; at 12 primitives bnb-exact's and bnb-tightest's took 45-65 s and 25-55 s under the sanitizers.
 std::uint32_t primitive_count(Algorithm algorithm) {
-    switch (algorithm) {
-        case Algorithm::optimal:
-        case Algorithm::automatic:
-        case Algorithm::bnb_exact:
-        case Algorithm::bnb_tightest: return 8;
-        default: return 12;
-    }
+    const bool exponential = algorithm == Algorithm::optimal || algorithm == Algorithm::automatic ||
+                             algorithm == Algorithm::bnb_exact || algorithm == Algorithm::bnb_tightest;
+    return exponential ? 8 : 12;
 }
 
 /// The band in which a pair may change its answer when the scene moves: 1e-12 of the coordinates' magnitude
@@ -200,7 +196,7 @@ int expect_same_up_to_band(const Pairs& at_origin, const Pairs& moved_pairs, con
 class PrecisionPerBuilder : public ::testing::TestWithParam<AlgorithmInfo> {};
 
 TEST_P(PrecisionPerBuilder, RigidMotionsKeepThePairsUpToTheBand) {
-    const Algorithm algorithm = GetParam().algorithm;
+    const Algorithm algorithm = GetParam().algorithm();
     int compared = 0, in_band = 0;
     const std::uint32_t count = primitive_count(algorithm);
     for (std::uint64_t seed = 1; seed <= 2; ++seed) {

@@ -217,15 +217,14 @@ TEST_P(TandemTraversalPerBuilder, MatchesBruteForce) {
     // primitives: their trees there have the same mixed kinds and several levels, and the two 27-primitive builds
     // were most of their 20-34 s (bnb-exact builds the tie interceptor's 27 primitives in 15 s under the sanitizers).
     std::uint32_t max_count = std::numeric_limits<std::uint32_t>::max();
-    switch (info.algorithm) {
-        case Algorithm::optimal: max_count = OptimalOptions{}.max_primitives; break;
-        case Algorithm::bnb_exact:
-        case Algorithm::bnb_tightest:
-        case Algorithm::bnb_enlarge: max_count = 20; break;
-        default: break;
-    }
+    const Algorithm algorithm = info.algorithm();
+    if (algorithm == Algorithm::optimal)
+        max_count = OptimalOptions{}.max_primitives;
+    else if (algorithm == Algorithm::bnb_exact || algorithm == Algorithm::bnb_tightest ||
+             algorithm == Algorithm::bnb_enlarge)
+        max_count = 20;
     check_builder(std::string(info.name), [&](std::span<const Primitive> primitives, std::uint64_t) {
-        auto built = build(primitives, info.algorithm);
+        auto built = build(primitives, info.algorithm());
         HBVH_ASSERT(built.has_value());
         return std::move(built).value();
     }, max_count);

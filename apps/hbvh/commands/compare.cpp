@@ -76,28 +76,25 @@ Result<Bvh> build_for_compare(const std::vector<Primitive>& primitives, Algorith
                               const CompareSettings& settings, BuildReport& report) {
     BuildContext context = settings.request.context.with_time_limit(settings.request.time_limit_seconds);
     context.report = &report;
-    switch (algorithm) {
-        case Algorithm::optimal: {
-            OptimalOptions options;
-            options.fall_back = false;
-            return build_optimal(primitives, context, options);
-        }
-        case Algorithm::bnb_tightest: {
-            BnbTightestOptions options;
-            if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
-            return build_bnb_tightest(primitives, context, options);
-        }
-        case Algorithm::bnb_enlarge: {
-            BnbEnlargeOptions options;
-            if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
-            return build_bnb_enlarge(primitives, context, options);
-        }
-        case Algorithm::bnb_exact: {
-            BnbExactOptions options;
-            if (settings.bnb_nodes > 0) options.enlarge_options.budget.max_nodes = settings.bnb_nodes;
-            return build_bnb_exact(primitives, context, options);
-        }
-        default: break;
+    if (algorithm == Algorithm::optimal) {
+        OptimalOptions options;
+        options.fall_back = false;
+        return build_optimal(primitives, context, options);
+    }
+    if (algorithm == Algorithm::bnb_tightest) {
+        BnbTightestOptions options;
+        if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
+        return build_bnb_tightest(primitives, context, options);
+    }
+    if (algorithm == Algorithm::bnb_enlarge) {
+        BnbEnlargeOptions options;
+        if (settings.bnb_nodes > 0) options.budget.max_nodes = settings.bnb_nodes;
+        return build_bnb_enlarge(primitives, context, options);
+    }
+    if (algorithm == Algorithm::bnb_exact) {
+        BnbExactOptions options;
+        if (settings.bnb_nodes > 0) options.enlarge_options.budget.max_nodes = settings.bnb_nodes;
+        return build_bnb_exact(primitives, context, options);
     }
     return build_requested(primitives, algorithm, context, settings.request.refine, settings.request.treelets);
 }
@@ -176,7 +173,7 @@ void print_json(const std::vector<Row>& rows) {
 int run_compare(const CompareArguments& args) {
     std::vector<Algorithm> chosen;
     if (args.algorithm_list.empty()) {
-        for (const AlgorithmInfo& info : algorithms()) chosen.push_back(info.algorithm);
+        for (const AlgorithmInfo& info : algorithms()) chosen.push_back(info.algorithm());
     } else {
         for (const std::string& name : split_names(args.algorithm_list)) {
             const std::optional<Algorithm> algorithm = parse_algorithm(name);
