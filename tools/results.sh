@@ -365,7 +365,7 @@ if wanted 1; then
         cheap=two-level,merge,insertion,insertion-haber,split,obbtree,scale,auto
         emit "Models of at most 30 primitives get every builder; larger ones only \`$cheap\`" \
              "(the survey's B&B builders, \`bnb-exact\` and \`optimal\` are exponential or need O(n³) fits and take" \
-             "minutes there). \`auto\` above 24 primitives keeps the cheapest of a portfolio led by \`scale\`" \
+             "minutes there). \`auto\` above 24 primitives keeps the cheapest of a portfolio (led by \`scale\` up to 32, by \`insertion-haber\` above)" \
              "(docs/scale.md §5). A model that does not load is left out." ""
         if ((${#small[@]} > 0)); then
             command_block "$hbvh compare ${small[*]} --markdown --repeat 3"

@@ -132,8 +132,12 @@ std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
     if (primitive_count <= auto_merge_max_primitives)
         return {Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::merge, Algorithm::scale,
                 Algorithm::binned};
-    if (primitive_count <= auto_insertion_max_primitives)
+    if (primitive_count <= auto_refine_each_max_primitives)
         return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::binned};
+    // Above, only the winner is refined, and scale and insertion never built the cheapest tree on 140 inputs of
+    // 33-200 primitives (docs/treelets.md §4): they would only cost time.
+    if (primitive_count <= auto_insertion_max_primitives)
+        return {Algorithm::insertion_haber, Algorithm::split, Algorithm::binned};
     if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::binned, Algorithm::split};
     return {Algorithm::binned};
 }

@@ -113,6 +113,8 @@ TEST(Auto, PicksBySizeAndSaysSo) {
     EXPECT_EQ(auto_choice(auto_optimal_max_primitives + 1), Algorithm::insertion_haber);
     EXPECT_EQ(auto_choice(auto_merge_max_primitives), Algorithm::insertion_haber);
     EXPECT_EQ(auto_choice(auto_merge_max_primitives + 1), Algorithm::scale);
+    EXPECT_EQ(auto_choice(auto_refine_each_max_primitives), Algorithm::scale);
+    EXPECT_EQ(auto_choice(auto_refine_each_max_primitives + 1), Algorithm::insertion_haber);
     ASSERT_EQ(parse_algorithm("auto"), Algorithm::automatic);
     for (std::uint32_t count : {5u, auto_optimal_max_primitives + 1, auto_merge_max_primitives + 10}) {
         const std::vector<Primitive> primitives = generated_scene(count, count);

@@ -20,7 +20,9 @@ namespace hbvh {
 /// auto_merge_max_primitives: the cheapest of insertion-haber, insertion, split, merge, scale and binned (none
 /// wins everywhere, docs/results.md §1; bnb-exact was a member too, at 60-80 % of auto's time there, and never
 /// strictly cheaper on the bundled and ../shared/data models: docs/treelets.md §4). Up to
-/// auto_insertion_max_primitives: the cheapest of scale, insertion-haber, insertion, split and binned; up to
+/// auto_refine_each_max_primitives: the cheapest of scale, insertion-haber, insertion, split and binned; up to
+/// auto_insertion_max_primitives: of insertion-haber, split and binned (scale and insertion never won there,
+/// docs/treelets.md §4); up to
 /// auto_portfolio_max_primitives: of binned and split (at 1000 primitives the insertions took 5-7 s, split
 /// 0.2 s, binned 0.3 s, and either may be the cheaper). Above: binned alone, 0.2 s and 0.2 % cheaper than split
 /// at 20 000 primitives, where split takes 3 s (docs/scale.md §9).
