@@ -8,6 +8,8 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <tuple>
+#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 
@@ -115,8 +117,19 @@ Mat3 frame_from_axis(const Vec3& axis) {
 }
 
 std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
-    // Stage 1: extremal spheres along each fixed direction (support value c.n +- r).
+    // Stage 1: extremal spheres along each fixed direction (support value c.n +- r), each sphere once (the same
+    // sphere is often extremal along several directions). The stages below take the first of equal values in
+    // list order, which a repeat never is, so leaving repeats out changes no frame and spares their pairs.
     std::vector<Vec3> extremal;
+    std::array<const Sphere*, 2 * std::tuple_size_v<std::remove_cvref_t<decltype(dito_normals())>>> taken{};
+    std::size_t taken_count = 0;
+    const auto take = [&](const Sphere* s) {
+        if (std::find(taken.begin(), taken.begin() + static_cast<std::ptrdiff_t>(taken_count), s) !=
+            taken.begin() + static_cast<std::ptrdiff_t>(taken_count))
+            return;
+        taken[taken_count++] = s;
+        extremal.push_back(s->center);
+    };
     extremal.reserve(2 * dito_normals().size());
     for (const Vec3& n : dito_normals()) {
         double low = infinity;
@@ -128,8 +141,8 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
             if (t - s.radius < low) low = t - s.radius, low_sphere = &s;
             if (t + s.radius > high) high = t + s.radius, high_sphere = &s;
         }
-        extremal.push_back(low_sphere->center);
-        extremal.push_back(high_sphere->center);
+        take(low_sphere);
+        take(high_sphere);
     }
 
     // Stage 2: the farthest pair among the extremal points is the first triangle edge. DiTO only compares
