@@ -8,8 +8,6 @@
 #include <limits>
 #include <optional>
 #include <span>
-#include <tuple>
-#include <type_traits>
 
 #include <Eigen/Eigenvalues>
 
@@ -28,13 +26,15 @@ Vec3 any_perpendicular(const Vec3& u) {
     return u.cross(Vec3::Unit(least)).normalized();
 }
 
+constexpr std::size_t dito_direction_count = 13;
+
 /// The 13 directions of DiTO-26 (Larsson & Källberg 2011, §2): the face, edge and vertex normals of
 /// a cube, one of each antipodal pair. Normalised so that support values with radii are distances.
-const std::array<Vec3, 13>& dito_normals() {
-    static const std::array<Vec3, 13> normals = [] {
-        std::array<Vec3, 13> n{Vec3(1, 0, 0),  Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 1),  Vec3(1, 1, -1),
-                               Vec3(1, -1, 1), Vec3(1, -1, -1), Vec3(1, 1, 0),  Vec3(1, -1, 0), Vec3(1, 0, 1),
-                               Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1)};
+const std::array<Vec3, dito_direction_count>& dito_normals() {
+    static const std::array<Vec3, dito_direction_count> normals = [] {
+        std::array<Vec3, dito_direction_count> n{
+            Vec3(1, 0, 0), Vec3(0, 1, 0),  Vec3(0, 0, 1),  Vec3(1, 1, 1),  Vec3(1, 1, -1), Vec3(1, -1, 1), Vec3(1, -1, -1),
+            Vec3(1, 1, 0), Vec3(1, -1, 0), Vec3(1, 0, 1),  Vec3(1, 0, -1), Vec3(0, 1, 1),  Vec3(0, 1, -1)};
         for (Vec3& v : n) v.normalize();
         return n;
     }();
@@ -42,8 +42,8 @@ const std::array<Vec3, 13>& dito_normals() {
 }
 
 /// The extent of points (xs[i], ys[i]) along the unit `d` and across it (along (-d.y, d.x)): low and high of
-/// each, by a pass over every point, two per step in SSE2 lanes. Each coordinate is computed as q.dot(d) and
-/// q.dot(perpendicular) compute it (x * d.x + y * d.y), and min and max are exact, so the lanes change no value.
+/// each, by a pass over every point, two per step in SSE2 lanes. Each coordinate is x * d.x + y * d.y, the
+/// products and sum Vector2d::dot forms, and min and max are exact, so the lanes change no value.
 struct PolygonExtent {
     double low_along, high_along, low_across, high_across;
 };
@@ -121,7 +121,7 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     // sphere is often extremal along several directions). The stages below take the first of equal values in
     // list order, which a repeat never is, so leaving repeats out changes no frame and spares their pairs.
     std::vector<Vec3> extremal;
-    std::array<const Sphere*, 2 * std::tuple_size_v<std::remove_cvref_t<decltype(dito_normals())>>> taken{};
+    std::array<const Sphere*, 2 * dito_direction_count> taken{};
     std::size_t taken_count = 0;
     const auto take = [&](const Sphere* s) {
         if (std::find(taken.begin(), taken.begin() + static_cast<std::ptrdiff_t>(taken_count), s) !=
