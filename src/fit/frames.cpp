@@ -124,13 +124,12 @@ std::vector<Mat3> dito_frames(std::span<const Sphere> spheres) {
     std::array<const Sphere*, 2 * dito_direction_count> taken{};
     std::size_t taken_count = 0;
     const auto take = [&](const Sphere* s) {
-        if (std::find(taken.begin(), taken.begin() + static_cast<std::ptrdiff_t>(taken_count), s) !=
-            taken.begin() + static_cast<std::ptrdiff_t>(taken_count))
-            return;
+        const std::span<const Sphere* const> seen = std::span(taken).first(taken_count);
+        if (std::ranges::find(seen, s) != seen.end()) return;
         taken[taken_count++] = s;
         extremal.push_back(s->center);
     };
-    extremal.reserve(2 * dito_normals().size());
+    extremal.reserve(2 * dito_direction_count);
     for (const Vec3& n : dito_normals()) {
         double low = infinity;
         double high = -infinity;
