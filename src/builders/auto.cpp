@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/builders/auto.hpp"
 
+#include <algorithm>
 #include <optional>
 #include <string>
 #include <vector>
@@ -36,17 +37,23 @@ Result<Bvh> build_member(std::span<const Primitive> primitives, Algorithm algori
     return build_binned(primitives, context, options);
 }
 
-/// `auto`: every member of auto_portfolio(n) builds a tree and the cheapest under Eq. 2 (first in the list
-/// on ties) wins. Up to auto_refine_each_max_primitives every member's tree is refined before the
-/// comparison (refinement from different starts ends in different local optima, docs/treelets.md §3);
-/// above, up to auto_refine_max_primitives, only the winner is. The members run in parallel (each is a
-/// function of the primitives alone, and the winner is chosen in list order afterwards, so the result does
-/// not depend on the thread count or on which finishes first).
+/// How many of the members' trees are refined before the comparison, the cheapest unrefined ones first.
+std::size_t members_to_refine(std::size_t primitive_count, std::size_t member_count, const AutoOptions& options) {
+    if (primitive_count <= auto_refine_each_max_primitives) return member_count;
+    if (primitive_count <= auto_refine_max_primitives) return std::min<std::size_t>(auto_refine_cheapest_members, member_count);
+    return options.refine_always ? 1 : 0;
+}
+
+/// `auto`: every member of auto_portfolio(n) builds a tree, the cheapest few under Eq. 2 are refined
+/// (members_to_refine: all of them up to auto_refine_each_max_primitives, since refinement from different starts
+/// ends in different local optima, docs/treelets.md §3), and the cheapest refined tree wins (first in the list on
+/// ties). The members build, and then refine, in parallel (each is a function of the primitives alone, and the
+/// trees to refine and the winner are chosen in list order afterwards, so the result does not depend on the
+/// thread count or on which finishes first).
 Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext& context, const AutoOptions& options) {
     const std::vector<Algorithm> members = auto_portfolio(primitives.size());
-    const bool refine_any = members.front() != Algorithm::optimal &&
-                            (options.refine_always || primitives.size() <= auto_refine_max_primitives);
-    const bool refine_each = refine_any && primitives.size() <= auto_refine_each_max_primitives;
+    const std::size_t refined_count =
+        members.front() == Algorithm::optimal ? 0 : members_to_refine(primitives.size(), members.size(), options);
     const bool limited = context.has_deadline();
     // The members' trees are over the same primitives and refined under the same policy, and their
     // treelets cover many of the same sets: one cache fits each set once for all of them.
@@ -64,45 +71,53 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         if (built) {
             outcome.cost = cost(*built, context.policy);
             outcome.costs = std::string(to_string(members[m])) + " " + detail::format_cost(outcome.cost);
-            if (refine_each) {
-                *built = detail::refine_treelets_cached(*built, context.policy,
-                                                        treelets_within(context, options.treelets), fits,
-                                                        &outcome.treelets);
-                outcome.cost = outcome.treelets.cost_after;
-                outcome.costs += " -> " + detail::format_cost(outcome.cost);
-            }
         }
         outcome.tree = std::move(built);
+    });
+    // The first error in list order ends the build; else the `refined_count` cheapest trees (list order on ties)
+    // are refined.
+    std::vector<std::size_t> built;
+    for (std::size_t m = 0; m < members.size(); ++m) {
+        if (!outcomes[m].tree) continue;
+        if (!*outcomes[m].tree) return std::move(*outcomes[m].tree);
+        built.push_back(m);
+    }
+    HBVH_ASSERT(!built.empty());  // the first member always runs
+    std::stable_sort(built.begin(), built.end(),
+                     [&](std::size_t a, std::size_t b) { return outcomes[a].cost < outcomes[b].cost; });
+    const std::size_t refine = std::min(refined_count, built.size());
+    tbb::parallel_for(std::size_t{0}, refine, [&](std::size_t r) {
+        MemberOutcome& outcome = outcomes[built[r]];
+        **outcome.tree = detail::refine_treelets_cached(**outcome.tree, context.policy,
+                                                        treelets_within(context, options.treelets), fits, &outcome.treelets);
+        outcome.cost = outcome.treelets.cost_after;
+        outcome.costs += " -> " + detail::format_cost(outcome.cost);
     });
     // The callback is called from the calling thread only (BuildContext::progress), so once the members are done.
     context.report_progress(static_cast<double>(members.size()) / static_cast<double>(members.size() + 1));
 
-    // The first error in list order, else the cheapest tree, the first on ties.
-    std::size_t winner = members.size();
+    // The cheapest tree wins, the first in the list on ties. An unrefined tree is no cheaper than the refined
+    // ones (they were the cheapest before refinement, which never adds cost), so only they compete when any is.
+    const std::vector<std::size_t> competing(built.begin(), built.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(refine, 1)));
+    const std::size_t winner = *std::min_element(competing.begin(), competing.end(), [&](std::size_t a, std::size_t b) {
+        return outcomes[a].cost != outcomes[b].cost ? outcomes[a].cost < outcomes[b].cost : a < b;
+    });
     std::string costs;
     std::string skipped;
     for (std::size_t m = 0; m < members.size(); ++m) {
-        const MemberOutcome& outcome = outcomes[m];
-        if (!outcome.tree) {
+        if (!outcomes[m].tree)
             skipped += (skipped.empty() ? "" : ", ") + std::string(to_string(members[m]));
-            continue;
-        }
-        if (!*outcome.tree) return std::move(*outcomes[m].tree);
-        costs += (costs.empty() ? "" : ", ") + outcome.costs;
-        if (winner == members.size() || outcome.cost < outcomes[winner].cost) winner = m;
+        else
+            costs += (costs.empty() ? "" : ", ") + outcomes[m].costs;
     }
-    HBVH_ASSERT(winner < members.size());  // the first member always runs
     Bvh best = std::move(**outcomes[winner].tree);
-    TreeletReport best_treelets = outcomes[winner].treelets;
-    if (refine_any && !refine_each)
-        best = detail::refine_treelets_cached(best, context.policy, treelets_within(context, options.treelets), fits,
-                                              &best_treelets);
+    const TreeletReport best_treelets = outcomes[winner].treelets;
     if (context.report != nullptr) {
         *context.report = std::move(outcomes[winner].report);
         const std::string kept(to_string(members[winner]));
         if (members.size() > 1)
             context.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, portfolio " +
-                                            costs + (refine_each ? " (each refined)" : "") + "; kept " + kept);
+                                            costs + "; kept " + kept);
         else
             context.report->notes.push_back("auto: " + std::to_string(primitives.size()) + " primitives, built with " +
                                             kept);
@@ -110,7 +125,7 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             context.report->notes.push_back("auto: time limit reached; skipped " + skipped);
             context.report->budget_hit = true;
         }
-        if (refine_any) note_treelets(*context.report, best_treelets);
+        if (refine > 0) note_treelets(*context.report, best_treelets);
     }
     return Result<Bvh>(std::move(best));
 }
@@ -134,8 +149,9 @@ std::vector<Algorithm> auto_portfolio(std::size_t primitive_count) {
                 Algorithm::binned};
     if (primitive_count <= auto_refine_each_max_primitives)
         return {Algorithm::scale, Algorithm::insertion_haber, Algorithm::insertion, Algorithm::split, Algorithm::binned};
-    // Above, only the winner is refined, and scale and insertion never built the cheapest tree on 140 inputs of
-    // 33-200 primitives (docs/treelets.md §4): they would only cost time.
+    // Above, only the two cheapest unrefined trees are refined, and scale and insertion never built the cheapest
+    // on 140 inputs of 33-200 primitives, nor the second cheapest on 47 of them (docs/treelets.md §4): they would
+    // only cost time.
     if (primitive_count <= auto_insertion_max_primitives)
         return {Algorithm::insertion_haber, Algorithm::split, Algorithm::binned};
     if (primitive_count <= auto_portfolio_max_primitives) return {Algorithm::binned, Algorithm::split};

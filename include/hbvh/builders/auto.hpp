@@ -26,13 +26,15 @@ namespace hbvh {
 /// auto_portfolio_max_primitives: of binned and split (at 1000 primitives the insertions took 5-7 s, split
 /// 0.2 s, binned 0.3 s, and either may be the cheaper). Above: binned alone, 0.2 s and 0.2 % cheaper than split
 /// at 20 000 primitives, where split takes 3 s (docs/scale.md §9).
-/// Treelet refinement (docs/treelets.md): of every member's tree before the comparison up to
-/// auto_refine_each_max_primitives, of the winner only up to auto_refine_max_primitives.
+/// Treelet refinement (docs/treelets.md), before the comparison: of every member's tree up to
+/// auto_refine_each_max_primitives, of the auto_refine_cheapest_members cheapest unrefined trees up to
+/// auto_refine_max_primitives (the cheapest unrefined tree alone lost up to 4.4 % to another member refined).
 inline constexpr std::uint32_t auto_optimal_max_primitives = 10;
 inline constexpr std::uint32_t auto_merge_max_primitives = 24;
 inline constexpr std::uint32_t auto_insertion_max_primitives = 200;
 inline constexpr std::uint32_t auto_portfolio_max_primitives = 2'000;
 inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
+inline constexpr std::uint32_t auto_refine_cheapest_members = 2;
 inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 
 /// Knobs of build_auto.
