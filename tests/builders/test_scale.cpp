@@ -134,6 +134,14 @@ TEST(Auto, PicksBySizeAndSaysSo) {
     }
 }
 
+// A member of auto's portfolio built alone, as auto builds it (binned without its net against split).
+Bvh member_alone(std::span<const Primitive> primitives, Algorithm member) {
+    BinnedOptions binned_alone;
+    binned_alone.guarantee_split_up_to = 0;
+    return member == Algorithm::binned ? build_binned(primitives, BuildContext{}, binned_alone).value()
+                                       : build(primitives, member, BuildContext{}).value();
+}
+
 // The members build and refine in parallel, sharing one fit cache; the winner is picked in list order
 // afterwards. With one thread or two, and against each member built and refined alone (its own cache,
 // one at a time), the same tree comes out.
@@ -147,15 +155,10 @@ TEST(Auto, SameTreeForOneAndTwoThreadsAndAsTheMembersAlone) {
         };
         const Bvh two = build_with(2);
         test_support::expect_identical_trees(build_with(1), two);
-        // The cheapest member refined alone, the first on ties, as a serial loop would find it (binned without its
-        // net against split, as auto builds it).
+        // The cheapest member refined alone, the first on ties, as a serial loop would find it.
         std::optional<Bvh> cheapest;
-        BinnedOptions binned_alone;
-        binned_alone.guarantee_split_up_to = 0;
         for (const Algorithm member : auto_portfolio(count)) {
-            const Bvh built = member == Algorithm::binned ? build_binned(primitives, BuildContext{}, binned_alone).value()
-                                                          : build(primitives, member, BuildContext{}).value();
-            const Bvh refined = refine_treelets(built, VolumePolicy::all());
+            const Bvh refined = refine_treelets(member_alone(primitives, member), VolumePolicy::all());
             if (!cheapest || cost(refined) < cost(*cheapest)) cheapest = refined;
         }
         test_support::expect_identical_trees(*cheapest, two);
@@ -174,11 +177,8 @@ TEST(Auto, RefinesTheTwoCheapestMembersAboveThirtyTwoPrimitives) {
         Bvh refined;
     };
     std::vector<Member> members;
-    BinnedOptions binned_alone;
-    binned_alone.guarantee_split_up_to = 0;
     for (const Algorithm member : auto_portfolio(count)) {
-        const Bvh built = member == Algorithm::binned ? build_binned(primitives, BuildContext{}, binned_alone).value()
-                                                      : build(primitives, member, BuildContext{}).value();
+        const Bvh built = member_alone(primitives, member);
         members.push_back({cost(built), refine_treelets(built, VolumePolicy::all())});
     }
     std::vector<std::size_t> by_raw_cost(members.size());
