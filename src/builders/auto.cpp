@@ -98,8 +98,8 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
 
     // The cheapest tree wins, the first in the list on ties. An unrefined tree is no cheaper than the refined
     // ones (they were the cheapest before refinement, which never adds cost), so only they compete when any is.
-    const std::vector<std::size_t> competing(built.begin(), built.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(refine, 1)));
-    const std::size_t winner = *std::min_element(competing.begin(), competing.end(), [&](std::size_t a, std::size_t b) {
+    const auto competing_end = built.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(refine, 1));
+    const std::size_t winner = *std::min_element(built.begin(), competing_end, [&](std::size_t a, std::size_t b) {
         return outcomes[a].cost != outcomes[b].cost ? outcomes[a].cost < outcomes[b].cost : a < b;
     });
     std::string costs;
