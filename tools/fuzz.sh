@@ -22,7 +22,11 @@ fi
 # Inputs per target in --ci mode: about 10 s each on the 2-core CI machine (the readers differ 100x in speed;
 # collide builds two hierarchies and runs two queries per input, about 15 s).
 declare -A ci_runs=([collide]=1200 [gltf]=1500 [mjcf]=15000 [obj]=300 [ply]=2500 [urdf]=20000 [xml]=150000 [binary]=400000)
-cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++-16 >/dev/null
+# -O1 and line tables only: the targets compiled in 191 s at RelWithDebInfo's -O2 -g and in 120 s so, and the
+# fixed-count runs took 82 s one after another against 75 s (docs/reliability.md §1); line tables are all a
+# sanitizer's stack needs.
+cmake -S fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only -DNDEBUG" -DCMAKE_CXX_COMPILER=clang++-16 >/dev/null
 cmake --build build-fuzz
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then

@@ -26,7 +26,7 @@ def assert_same_stats(ours, theirs):
 @pytest.mark.parametrize("source", ["chair.xml", "tie_interceptor.xml", "generated"])
 @pytest.mark.parametrize("extension", [".xml", ".hbvh"])
 def test_cost_and_stats_equal_the_cli(cli, tmp_path, source, extension):
-    # bnb-exact takes tens of seconds on the 80 generated primitives with capsules excluded: split there. The
+    # bnb-exact takes tens of seconds on the 40 generated primitives with capsules excluded: split there. The
     # .xml and .hbvh cases save the same tree.
     algorithm = "split" if source == "generated" else "bnb-exact"
     tree = built(source, algorithm, "aabb,obb,sphere")
