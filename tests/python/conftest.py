@@ -64,9 +64,9 @@ def model(name):
 
 def built(name, algorithm="auto", types=None):
     """hbvh.build(model(name), ...), built once per session: several tests query the same tree (read only), and
-    the builds dominate the suite's time under the sanitizers (auto over 80 generated primitives took 10-13 s,
-    which is why the generated and round sets hold 40 each: still above 32, where auto refines two members).
-    Builds are deterministic, so a rebuild would be the same tree."""
+    the builds dominate the suite's time under the sanitizers (auto over 80 generated primitives took 10-13 s and
+    over 40 about 5 s, which is why the generated and round sets hold 40 each and auto builds only the bundled
+    models). Builds are deterministic, so a rebuild would be the same tree."""
     return _built(name, algorithm, types)
 
 

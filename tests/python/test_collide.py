@@ -14,8 +14,11 @@ def extent(primitives):
     return float(np.linalg.norm(a["p1"] - a["p0"], axis=1).max() + reach.max())
 
 
-@pytest.mark.parametrize("name", ["chair.xml", "tie_interceptor.xml", "generated", "round"])
-@pytest.mark.parametrize("algorithm", ["auto", "fast", "split", "two-level"])
+# auto on the two bundled models only: its 40-primitive builds took 5 s each under the sanitizers, and which
+# builder made a tree is no concern of the binding (the C++ suite checks auto's trees against brute force).
+@pytest.mark.parametrize("name,algorithm", [(name, algorithm) for name in ["chair.xml", "tie_interceptor.xml", "generated", "round"]
+                                            for algorithm in ["auto", "fast", "split", "two-level"]
+                                            if algorithm != "auto" or name.endswith(".xml")])
 def test_pairs_equal_brute_force(name, algorithm):
     primitives = model(name)
     assert isinstance(primitives, hbvh.Primitives)
@@ -48,7 +51,7 @@ def test_pairs_equal_brute_force(name, algorithm):
 
 @pytest.mark.parametrize("name", ["chair.xml", "generated"])
 def test_two_different_models(name):
-    a = built(name)
+    a = built(name, "auto" if name.endswith(".xml") else "split")
     b_primitives = model("round")
     b = built("round", "merge")
     rng = np.random.default_rng(3)
@@ -61,7 +64,7 @@ def test_two_different_models(name):
 @pytest.mark.parametrize("name", ["tie_interceptor.xml", "generated"])
 def test_collide_many_equals_repeated_collide(name):
     primitives = model(name)
-    a = built(name)
+    a = built(name, "split")
     b = built(name, "insertion")
     poses = random_poses(np.random.default_rng(5), 50, extent(primitives))
     many = hbvh.collide_many(a, b, poses)

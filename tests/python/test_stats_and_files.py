@@ -26,9 +26,10 @@ def assert_same_stats(ours, theirs):
 @pytest.mark.parametrize("source", ["chair.xml", "tie_interceptor.xml", "generated"])
 @pytest.mark.parametrize("extension", [".xml", ".hbvh"])
 def test_cost_and_stats_equal_the_cli(cli, tmp_path, source, extension):
-    # bnb-exact takes tens of seconds on the 40 generated primitives with capsules excluded: split there. The
-    # .xml and .hbvh cases save the same tree.
-    algorithm = "split" if source == "generated" else "bnb-exact"
+    # An exact builder on the chair, split on the others: bnb-exact takes tens of seconds on the 40 generated
+    # primitives with capsules excluded under the sanitizers, and 8 s on the tie interceptor's 27, for statistics
+    # that any tree shows. The .xml and .hbvh cases save the same tree.
+    algorithm = "bnb-exact" if source == "chair.xml" else "split"
     tree = built(source, algorithm, "aabb,obb,sphere")
     stats = tree.stats()
     assert list(stats) == STATS_KEYS
