@@ -19,8 +19,10 @@ cmake -S . -B build-test -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_
 cmake --build build-test
 phase "test suite under the sanitizers"
 # The first report is fatal, so ctest sees it; leaks fail too, except inside assimp and urdfdom (fuzz/lsan.supp).
+# A 64 MB quarantine (ASan's default is 256) keeps freed memory poisoned long enough for these small tests and
+# cut the fitters' time under ASan by a fifth: fewer fresh pages to fault in (docs/reliability.md §2).
 export LSAN_OPTIONS="${LSAN_OPTIONS:-suppressions=$PWD/fuzz/lsan.supp:print_suppressions=0}"
-export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=1}"
+export ASAN_OPTIONS="${ASAN_OPTIONS:-detect_leaks=1:halt_on_error=1:abort_on_error=1:quarantine_size_mb=64}"
 export UBSAN_OPTIONS="${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}"
 ctest --test-dir build-test --output-on-failure -j2
 phase "fuzz ($fuzz_mode)"
