@@ -32,9 +32,32 @@ struct HorizonEdge {
     int edge;
 };
 
+/// The growing hull's arrays, kept from one call to the next on each thread (quickhull()).
+struct QuickhullBuffers {
+    std::vector<Face> faces;
+    std::vector<std::uint32_t> next_outside;
+    std::vector<std::uint32_t> pending;
+    std::vector<std::uint32_t> visible;
+    std::vector<HorizonEdge> horizon;
+    std::vector<std::uint32_t> loop_vertices;
+    std::vector<std::uint32_t> new_faces;
+    std::vector<std::uint32_t> output_index;
+};
+
 class Quickhull {
 public:
-    explicit Quickhull(std::span<const Vec3> points) : points_(points), next_outside_(points.size(), none) {}
+    Quickhull(std::span<const Vec3> points, QuickhullBuffers& buffers)
+        : points_(points), faces_(buffers.faces), next_outside_(buffers.next_outside), pending_(buffers.pending),
+          visible_(buffers.visible), horizon_(buffers.horizon), loop_vertices_(buffers.loop_vertices),
+          new_faces_(buffers.new_faces), output_index_(buffers.output_index) {
+        faces_.clear();
+        next_outside_.assign(points.size(), none);
+        pending_.clear();
+        visible_.clear();
+        horizon_.clear();
+        loop_vertices_.clear();
+        new_faces_.clear();
+    }
 
     std::optional<TriangleHull> run() {
         if (points_.size() < 4) return std::nullopt;
@@ -246,7 +269,8 @@ private:
     /// The live faces as a TriangleHull, after checking that they close up as a triangulated sphere.
     std::optional<TriangleHull> finish() {
         TriangleHull hull;
-        std::vector<std::uint32_t> output_index(faces_.size(), none);
+        std::vector<std::uint32_t>& output_index = output_index_;
+        output_index.assign(faces_.size(), none);
         for (std::uint32_t f = 0; f < faces_.size(); ++f) {
             if (!faces_[f].alive) continue;
             output_index[f] = static_cast<std::uint32_t>(hull.triangles.size());
@@ -272,17 +296,24 @@ private:
     std::span<const Vec3> points_;
     double tolerance_ = 0.0;
     bool linked_ = true;  ///< Cleared when two neighbours disagree about their shared edge.
-    std::vector<Face> faces_;
-    std::vector<std::uint32_t> next_outside_;
-    std::vector<std::uint32_t> pending_;
-    std::vector<std::uint32_t> visible_;
-    std::vector<HorizonEdge> horizon_;
-    std::vector<std::uint32_t> loop_vertices_;
-    std::vector<std::uint32_t> new_faces_;
+    std::vector<Face>& faces_;
+    std::vector<std::uint32_t>& next_outside_;
+    std::vector<std::uint32_t>& pending_;
+    std::vector<std::uint32_t>& visible_;
+    std::vector<HorizonEdge>& horizon_;
+    std::vector<std::uint32_t>& loop_vertices_;
+    std::vector<std::uint32_t>& new_faces_;
+    std::vector<std::uint32_t>& output_index_;
 };
 
 }  // namespace
 
-std::optional<TriangleHull> quickhull(std::span<const Vec3> points) { return Quickhull(points).run(); }
+std::optional<TriangleHull> quickhull(std::span<const Vec3> points) {
+    // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel, and the
+    // page faults were a tenth of auto's time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
+    // largest hull that thread has built (at most quickhull_max_points points) and stay there.
+    thread_local QuickhullBuffers buffers;
+    return Quickhull(points, buffers).run();
+}
 
 }  // namespace hbvh::detail
