@@ -309,8 +309,8 @@ private:
 }  // namespace
 
 std::optional<TriangleHull> quickhull(std::span<const Vec3> points) {
-    // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel, and the
-    // page faults were a tenth of auto's time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
+    // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel: half the
+    // page faults of auto over the MuJoCo cards, and a tenth of its time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
     // largest hull that thread has built (at most quickhull_max_points points) and stay there.
     thread_local QuickhullBuffers buffers;
     return Quickhull(points, buffers).run();
