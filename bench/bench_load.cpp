@@ -24,7 +24,6 @@
 // pugixml for the anchor row: linked through hbvh::io's static archive, which carries it as a link-only dependency.
 #include <pugixml.hpp>
 
-#include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
 
@@ -34,6 +33,7 @@
 #include <iterator>
 #include <map>
 #include <optional>
+#include <span>
 #include <string>
 #include <thread>
 #include <vector>
@@ -44,6 +44,8 @@
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/binary_format.hpp"
+#include "memory/huge_pages.hpp"
+#include "tree/binary_decoding.hpp"
 
 namespace hbvh::bench {
 void fail(benchmark::State& state, const std::string& message);
@@ -206,42 +208,42 @@ void load_query_tree(benchmark::State& state, std::uint32_t count) {
 void load_floor(benchmark::State& state, std::uint32_t count) {
     Result<StoredTree> tree = stored_trees().get(count);
     if (!tree) return fail(state, tree.error().to_string());
-    const int fd = ::open(tree->binary.c_str(), O_RDONLY);
-    if (fd < 0) return fail(state, "cannot open " + tree->binary.string());
-    const std::size_t file_bytes = tree->binary_bytes;
     const std::size_t output_bytes = tree->nodes * sizeof(Node) + tree->primitives * sizeof(Primitive);
     std::uint64_t checksum = 0;
-    auto once = [&] {
-        void* file = ::mmap(nullptr, file_bytes, PROT_READ, MAP_PRIVATE | MAP_POPULATE, fd, 0);
+    // The file's bytes as the loader gets them (detail::with_file_bytes: mapped when large), the output as fresh
+    // memory advised as the loader advises its arrays.
+    auto once = [&]() -> Status {
         void* output = ::mmap(nullptr, output_bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
-        if (file == MAP_FAILED || output == MAP_FAILED) return false;
-        ::madvise(output, output_bytes, MADV_HUGEPAGE);
-        std::uint64_t sums[2] = {0, 0};
-        auto half = [&](int k) {
-            const auto* words = static_cast<const std::uint64_t*>(file);
-            const std::size_t word_count = file_bytes / sizeof(std::uint64_t);
-            std::uint64_t sum = 0;
-            for (std::size_t i = k * word_count / 2; i < (k + 1) * word_count / 2; ++i) sum += words[i];
-            sums[k] = sum;
-            std::memset(static_cast<char*>(output) + k * (output_bytes / 2), 1,
-                        k == 0 ? output_bytes / 2 : output_bytes - output_bytes / 2);
-        };
-        std::thread other(half, 1);
-        half(0);
-        other.join();
-        checksum += sums[0] + sums[1] + static_cast<unsigned char*>(output)[output_bytes - 1];
+        if (output == MAP_FAILED) return Error{"mmap of the output failed"};
+        detail::advise_huge_pages(output, output_bytes);
+        const Status read = detail::with_file_bytes(tree->binary, [&](std::span<const std::byte> file) {
+            std::uint64_t sums[2] = {0, 0};
+            auto half = [&](int k) {
+                const auto* words = reinterpret_cast<const std::uint64_t*>(file.data());
+                const std::size_t word_count = file.size() / sizeof(std::uint64_t);
+                std::uint64_t sum = 0;
+                for (std::size_t i = k * word_count / 2; i < (k + 1) * word_count / 2; ++i) sum += words[i];
+                sums[k] = sum;
+                std::memset(static_cast<char*>(output) + k * (output_bytes / 2), 1,
+                            k == 0 ? output_bytes / 2 : output_bytes - output_bytes / 2);
+            };
+            std::thread other(half, 1);
+            half(0);
+            other.join();
+            checksum += sums[0] + sums[1] + static_cast<unsigned char*>(output)[output_bytes - 1];
+        });
         ::munmap(output, output_bytes);
-        ::munmap(file, file_bytes);
-        return true;
+        return read;
     };
-    bool mapped = once();  // untimed warm-up, as for the other rows
+    Status done = once();  // untimed warm-up, as for the other rows
     const auto start = std::chrono::steady_clock::now();
-    for (auto _ : state) mapped = mapped && once();
+    for (auto _ : state) {
+        if (done) done = once();
+    }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    ::close(fd);
-    if (!mapped) return fail(state, "mmap failed");
+    if (!done) return fail(state, done.error().to_string());
     benchmark::DoNotOptimize(checksum);
-    state.counters["MB_read"] = static_cast<double>(file_bytes) / 1e6;
+    state.counters["MB_read"] = static_cast<double>(tree->binary_bytes) / 1e6;
     state.counters["MB_written"] = static_cast<double>(output_bytes) / 1e6;
     if (const auto xml = xml_seconds().find(count); xml != xml_seconds().end())
         state.counters["max_speedup_vs_xml"] = xml->second / (seconds / static_cast<double>(state.iterations()));
