@@ -400,7 +400,8 @@ TEST(BinaryFormat, OnTheFlyChecksAgreeWithTheFullChecks) {
 }
 
 TEST(BinaryFormat, FileHelpersReadFromAPipe) {
-    // No size to go by: the reader grows its buffer as the bytes come (here beyond eight times its first 64 KiB).
+    // No size to go by: the reader grows its buffer as the bytes come (here more than eight 64 KiB chunks). The
+    // fifo is opened once: opened, closed and reopened, it would leave the writer without a reader (SIGPIPE).
     const std::filesystem::path dir = std::filesystem::path(testing::TempDir()) / "hbvh_binary_format_pipe";
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
