@@ -61,6 +61,21 @@ ssize_t read_some(int fd, char* data, std::size_t size) {
     }
 }
 
+/// Writes `content` into the existing non-regular file at `path` (a device, fifo or socket), without truncating
+/// or replacing it.
+Status write_into_stream(const std::filesystem::path& path, std::string_view content) {
+    const std::string name = path.string();
+    int fd = -1;
+    do {
+        fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+    } while (fd < 0 && errno == EINTR);
+    if (fd < 0) return Error("cannot open for writing: " + describe(errno), name);
+    FileDescriptor stream(fd);
+    if (const int code = write_all(stream.get(), content); code != 0) return Error("cannot write: " + describe(code), name);
+    if (const int code = stream.close_checked(); code != 0) return Error("cannot write: " + describe(code), name);
+    return Ok{};
+}
+
 /// A name for the temporary file that no other writer (thread or process) picks at the same time.
 /// Hidden (leading dot) so directory listings and globs don't catch a half-written file.
 std::filesystem::path temporary_name(const std::filesystem::path& target, unsigned attempt) {
@@ -117,6 +132,13 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
 Status write_file_atomic(const std::filesystem::path& path, std::string_view content) {
     const std::string name = path.string();
     if (path.empty() || !path.has_filename()) return Error("not a file name", name);
+
+    // A path that names a stream rather than a file (a terminal or pipe behind /dev/stdout, /dev/null, a fifo,
+    // a socket; symbolic links followed) is written into as it is: there is nothing to replace atomically, and
+    // renaming over it would put a regular file where the device or link was (as root, /dev/stdout itself).
+    if (struct stat target {}; ::stat(path.c_str(), &target) == 0 && !S_ISREG(target.st_mode) &&
+                               !S_ISDIR(target.st_mode))
+        return write_into_stream(path, content);
 
     // Stage 1: create a fresh temporary file next to the target. Same directory means same file system,
     // which rename() needs to be atomic. O_EXCL guarantees we never write into someone else's file.

@@ -3,6 +3,7 @@
 #include "hbvh/files.hpp"
 
 #include <gtest/gtest.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -108,6 +109,43 @@ TEST_F(FileTest, ReadsAFileLargerThanOneChunk) {
     const fs::path path = directory_ / "big";
     ASSERT_TRUE(write_file_atomic(path, content));
     EXPECT_EQ(read_text_file(path)->size(), content.size());
+}
+
+TEST_F(FileTest, AStreamIsWrittenIntoNotReplaced) {
+    // A fifo, and a symbolic link to it (as /dev/stdout links to the process's output): the bytes arrive in the
+    // pipe, and both stay what they were instead of becoming regular files. The test holds the fifo open for
+    // reading and writing without blocking, so the content (less than a pipe's buffer) needs no reader thread,
+    // and a fifo replaced by a file shows as an empty read instead of a hang.
+    const fs::path fifo = directory_ / "stream";
+    const fs::path link = directory_ / "link";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    fs::create_symlink(fifo, link);
+    const int pipe_end = ::open(fifo.c_str(), O_RDWR | O_NONBLOCK | O_CLOEXEC);
+    ASSERT_GE(pipe_end, 0);
+    for (const fs::path& target : {fifo, link}) {
+        const std::string content = "through " + target.filename().string() + std::string(3000, '.');
+        const Status status = write_file_atomic(target, content);
+        ASSERT_TRUE(status) << status.error().to_string();
+        std::string received(8192, '\0');
+        const ssize_t count = ::read(pipe_end, received.data(), received.size());
+        received.resize(count > 0 ? static_cast<std::size_t>(count) : 0);
+        EXPECT_EQ(received, content) << target;
+    }
+    ::close(pipe_end);
+    EXPECT_TRUE(fs::is_fifo(fs::symlink_status(fifo)));
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+    EXPECT_EQ(entries(), (std::vector<std::string>{"link", "stream"}));
+}
+
+TEST_F(FileTest, ALinkToARegularFileIsReplacedNotFollowed) {
+    const fs::path file = directory_ / "file";
+    const fs::path link = directory_ / "link";
+    std::ofstream(file) << "kept";
+    fs::create_symlink(file, link);
+    ASSERT_TRUE(write_file_atomic(link, "new"));
+    EXPECT_FALSE(fs::is_symlink(fs::symlink_status(link)));
+    EXPECT_EQ(*read_text_file(link), "new");
+    EXPECT_EQ(*read_text_file(file), "kept");
 }
 
 }  // namespace
