@@ -10,6 +10,7 @@
 #include "hbvh/io/mjcf.hpp"
 #include "hbvh/io/urdf.hpp"
 #include "hbvh/io/xml.hpp"
+#include "import_format.hpp"
 #include "xml_source.hpp"
 
 namespace hbvh {
@@ -18,10 +19,7 @@ namespace {
 Result<ImportFormat> format_from_path(const std::string& path) {
     const std::string extension = lower_case_extension(path);
     if (extension == ".urdf") return ImportFormat::urdf;
-    static constexpr std::array<std::string_view, 7> mesh_extensions{".gltf", ".glb", ".obj", ".fbx",
-                                                                     ".dae",  ".stl", ".ply"};
-    if (std::find(mesh_extensions.begin(), mesh_extensions.end(), extension) != mesh_extensions.end())
-        return ImportFormat::mesh;
+    if (detail::is_mesh_extension(extension)) return ImportFormat::mesh;
     if (extension == ".xml") {
         // MJCF, URDF saved as .xml, and the survey format share the extension: the root element decides.
         Result<std::unique_ptr<detail::XmlSource>> source = detail::XmlSource::load(path);
@@ -37,6 +35,20 @@ Result<ImportFormat> format_from_path(const std::string& path) {
 }
 
 }  // namespace
+
+namespace detail {
+
+bool is_mesh_extension(std::string_view extension) {
+    static constexpr std::array<std::string_view, 7> mesh_extensions{".gltf", ".glb", ".obj", ".fbx",
+                                                                     ".dae",  ".stl", ".ply"};
+    return std::find(mesh_extensions.begin(), mesh_extensions.end(), extension) != mesh_extensions.end();
+}
+
+bool is_import_extension(std::string_view extension) {
+    return extension == ".xml" || extension == ".urdf" || is_mesh_extension(extension);
+}
+
+}  // namespace detail
 
 Result<ImportResult> import_primitives(const std::string& path, ImportFormat format) {
     if (format == ImportFormat::automatic) {

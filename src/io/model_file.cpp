@@ -18,6 +18,7 @@
 #include "hbvh/tree/binary_format.hpp"
 #include "hbvh/tree/refit.hpp"
 #include "hbvh/tree/validate.hpp"
+#include "import_format.hpp"
 #include "xml_taking.hpp"
 
 namespace hbvh {
@@ -79,19 +80,37 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         return from_import(import_mesh(path, options), path);
     }
     // The survey format keeps a stored hierarchy; the importers give primitives only.
+    if (format == "hbvh") return from_binary(read_binary_file(path));
     static const std::pair<std::string_view, ImportFormat> formats[] = {
         {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
         {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
     const auto chosen = std::find_if(std::begin(formats), std::end(formats),
                                      [&](const auto& entry) { return format == entry.first; });
     if (chosen == std::end(formats))
-        return Error{"unknown input format '" + std::string(format) + "' (expected xml, mjcf, urdf, mesh or mesh-nodes)",
+        return Error{"unknown input format '" + std::string(format) +
+                         "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)",
                      path};
 
     const bool automatic = chosen->second == ImportFormat::automatic;
     const std::string extension = lower_case_extension(path);
     // A .hbvh name goes to the binary reader's own file path, which maps a large file instead of copying it.
     if (automatic && extension == ".hbvh") return from_binary(read_binary_file(path));
+    // A name that tells nothing (a pipe such as /dev/stdin or <(...), a file without an extension) is read once
+    // and decided by its bytes, for the two formats read from bytes: .hbvh and survey XML. The importers take
+    // paths (MJCF's includes, meshes' textures), so for those --format must name the format.
+    if (automatic && !detail::is_import_extension(extension)) {
+        Result<std::string> bytes = read_text_file(path);
+        if (!bytes) return bytes.error();
+        const std::span<const std::byte> raw = std::as_bytes(std::span(bytes.value()));
+        if (has_binary_magic(raw)) return from_binary(read_binary(raw, path));
+        if (bytes->find("<hierarchy") != std::string::npos)
+            return from_xml(detail::read_xml_taking(std::move(bytes).value(), path));
+        return Error{"unknown file type '" + extension +
+                         "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format "
+                         "(hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
+                         ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
+                     path};
+    }
     if (chosen->second == ImportFormat::survey_xml || (automatic && extension == ".xml")) {
         Result<std::string> text = read_text_file(path);
         if (!text) return text.error();

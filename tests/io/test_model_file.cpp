@@ -8,7 +8,10 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <thread>
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -94,6 +97,48 @@ TEST_F(ModelFileTest, StoredHierarchiesComeBackFromXmlAndBinaryWhateverTheName) 
     ASSERT_FALSE(cut.has_value());
     EXPECT_EQ(cut.error().file, "asset");
     EXPECT_NE(cut.error().message.find("truncated"), std::string::npos) << cut.error().message;
+}
+
+TEST_F(ModelFileTest, ANameThatTellsNothingIsReadByItsBytes) {
+    const Bvh tree = test::sample_hierarchy();
+    const std::string binary = write_binary(tree);
+    write("tree", binary);
+    write("tree.bin", binary);
+    write("set", write_primitives_xml(tree.primitives));
+    for (const std::string name : {"tree", "tree.bin"}) {
+        const Result<ModelFile> read = read_model_file(path(name));
+        ASSERT_TRUE(read.has_value()) << name << ": " << read.error().to_string();
+        expect_same(*read, tree);
+    }
+    const Result<ModelFile> set = read_model_file(path("set"));
+    ASSERT_TRUE(set.has_value()) << set.error().to_string();
+    EXPECT_EQ(set->primitives.size(), tree.primitives.size());
+    const Result<ModelFile> named = read_model_file(path("tree"), "hbvh");
+    ASSERT_TRUE(named.has_value()) << named.error().to_string();
+    expect_same(*named, tree);
+    const Result<ModelFile> not_binary = read_model_file(path("set"), "hbvh");
+    ASSERT_FALSE(not_binary.has_value());
+    EXPECT_NE(not_binary.error().message.find("not an .hbvh file"), std::string::npos) << not_binary.error().message;
+
+    // A pipe (as `hbvh stats <(...)` passes /dev/fd/N): one reader, the bytes decide.
+    const fs::path fifo = folder_ / "pipe";
+    ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+    std::thread writer([&] { std::ofstream(fifo, std::ios::binary) << binary; });
+    const Result<ModelFile> piped = read_model_file(fifo.string());
+    // Should the reader never have opened the pipe, this open releases the writer, so the test fails, not hangs.
+    const int release = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    writer.join();
+    if (release >= 0) ::close(release);
+    ASSERT_TRUE(piped.has_value()) << piped.error().to_string();
+    expect_same(*piped, tree);
+
+    // MJCF under a name that tells nothing is not guessed: the importers read paths (includes, meshes).
+    write("robot", "<mujoco><worldbody><geom type='sphere' size='1'/></worldbody></mujoco>");
+    const Result<ModelFile> mjcf = read_model_file(path("robot"));
+    ASSERT_FALSE(mjcf.has_value());
+    EXPECT_EQ(mjcf.error().file, path("robot"));
+    EXPECT_NE(mjcf.error().message.find("--format"), std::string::npos) << mjcf.error().message;
+    ASSERT_TRUE(read_model_file(path("robot"), "mjcf").has_value());
 }
 
 TEST_F(ModelFileTest, ImportersByExtensionRootAndFormat) {

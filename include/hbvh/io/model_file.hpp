@@ -32,8 +32,9 @@ struct ModelFile {
 
 /// Reads `path` as `format` says: "" decides by the name and the content (.hbvh, or bytes that start with
 /// binary_magic: the binary format; .xml: MJCF when its root is <mujoco>, else the survey format; .urdf; the mesh
-/// extensions of import_primitives), "xml" (survey XML or .hbvh bytes), "mjcf", "urdf", "mesh", or "mesh-nodes"
-/// (a plain mesh, one fitted primitive per mesh node). A large .hbvh file is mapped rather than copied. Errors
+/// extensions of import_primitives; any other name, a pipe's among them: .hbvh bytes or survey XML by the bytes,
+/// else an error), "hbvh", "xml" (survey XML or .hbvh bytes), "mjcf", "urdf", "mesh", or "mesh-nodes" (a plain
+/// mesh, one fitted primitive per mesh node). A large .hbvh file is mapped rather than copied. Errors
 /// name the file: a directory, an unknown format, the reader's or importer's own error, and a file that yields
 /// no primitive (with the first three candidates the importer skipped, and why). Nothing is checked across
 /// primitives or nodes: validate_primitives, check_structure and containment_violations are the caller's.
