@@ -83,7 +83,15 @@ std::filesystem::path temporary_name(const std::filesystem::path& target, unsign
     const auto ticks = static_cast<unsigned long long>(std::chrono::steady_clock::now().time_since_epoch().count());
     // Appended piece by piece: GCC 12 warns falsely (-Wrestrict) on the chain of operator+ this was.
     std::string name(1, '.');
-    for (const std::string& part : {target.filename().string(), std::string(".tmp-"), std::to_string(::getpid()),
+    // At most 100 bytes of the target's name (cut at a UTF-8 character's start), so that a legal name near the
+    // file system's 255-byte limit still leaves room for the suffix.
+    std::string stem = target.filename().string();
+    if (stem.size() > 100) {
+        std::size_t cut = 100;
+        while (cut > 0 && (static_cast<unsigned char>(stem[cut]) & 0xC0) == 0x80) --cut;
+        stem.resize(cut);
+    }
+    for (const std::string& part : {stem, std::string(".tmp-"), std::to_string(::getpid()),
                                     std::string(1, '-'), std::to_string(counter.fetch_add(1)), std::string(1, '-'),
                                     std::to_string(ticks % 1000000007ULL), std::string(1, '-'), std::to_string(attempt)})
         name += part;
@@ -129,17 +137,10 @@ Result<std::string> read_text_file(const std::filesystem::path& path) {
     return content;
 }
 
-Status write_file_atomic(const std::filesystem::path& path, std::string_view content) {
-    const std::string name = path.string();
-    if (path.empty() || !path.has_filename()) return Error("not a file name", name);
+namespace {
 
-    // A path that names a stream rather than a file (a terminal or pipe behind /dev/stdout, /dev/null, a fifo,
-    // a socket; symbolic links followed) is written into as it is: there is nothing to replace atomically, and
-    // renaming over it would put a regular file where the device or link was (as root, /dev/stdout itself).
-    if (struct stat target {}; ::stat(path.c_str(), &target) == 0 && !S_ISREG(target.st_mode) &&
-                               !S_ISDIR(target.st_mode))
-        return write_into_stream(path, content);
-
+/// Replaces the regular file at `path` (or creates it) through a temporary file and rename; errors name `name`.
+Status replace_file(const std::filesystem::path& path, std::string_view content, const std::string& name) {
     // Stage 1: create a fresh temporary file next to the target. Same directory means same file system,
     // which rename() needs to be atomic. O_EXCL guarantees we never write into someone else's file.
     std::filesystem::path temporary;
@@ -176,6 +177,42 @@ Status write_file_atomic(const std::filesystem::path& path, std::string_view con
         ::close(directory_fd);
     }
     return Ok{};
+}
+
+}  // namespace
+
+Status write_file_atomic(const std::filesystem::path& path, std::string_view content) {
+    const std::string name = path.string();
+    if (path.empty() || !path.has_filename()) return Error("not a file name", name);
+
+    struct stat target {};
+    if (::stat(path.c_str(), &target) == 0) {  // symbolic links followed
+        // The process's own standard output or error (/dev/stdout, /dev/fd/1, or the file the shell redirected
+        // it to): written through that descriptor, with the offset and flags the shell gave it (`>>` appends).
+        // Replacing the file would leave the shell's descriptor on the old one; replacing /dev/stdout, as root,
+        // would replace the device link itself.
+        for (const int descriptor : {STDOUT_FILENO, STDERR_FILENO}) {
+            struct stat open_file {};
+            if (::fstat(descriptor, &open_file) == 0 && open_file.st_dev == target.st_dev &&
+                open_file.st_ino == target.st_ino) {
+                if (const int code = write_all(descriptor, content); code != 0)
+                    return Error("cannot write: " + describe(code), name);
+                return Ok{};
+            }
+        }
+        // A stream rather than a file (a terminal, pipe, fifo, socket or device such as /dev/null): there is
+        // nothing to replace atomically, and renaming over it would put a regular file where it was.
+        if (!S_ISREG(target.st_mode) && !S_ISDIR(target.st_mode)) return write_into_stream(path, content);
+        // A symbolic link to a file: the file it names is replaced and the link kept, as editors do.
+        if (struct stat link {}; ::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+            if (S_ISDIR(target.st_mode)) return Error("is a symbolic link to a directory, not a file", name);
+            std::error_code error;
+            const std::filesystem::path resolved = std::filesystem::canonical(path, error);
+            if (error) return Error("cannot follow the symbolic link: " + error.message(), name);
+            return replace_file(resolved, content, name);
+        }
+    }
+    return replace_file(path, content, name);
 }
 
 }  // namespace hbvh

@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -137,15 +138,62 @@ TEST_F(FileTest, AStreamIsWrittenIntoNotReplaced) {
     EXPECT_EQ(entries(), (std::vector<std::string>{"link", "stream"}));
 }
 
-TEST_F(FileTest, ALinkToARegularFileIsReplacedNotFollowed) {
+TEST_F(FileTest, ALinkToAFileIsFollowedAndKept) {
     const fs::path file = directory_ / "file";
     const fs::path link = directory_ / "link";
-    std::ofstream(file) << "kept";
+    std::ofstream(file) << "old";
     fs::create_symlink(file, link);
     ASSERT_TRUE(write_file_atomic(link, "new"));
-    EXPECT_FALSE(fs::is_symlink(fs::symlink_status(link)));
-    EXPECT_EQ(*read_text_file(link), "new");
-    EXPECT_EQ(*read_text_file(file), "kept");
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+    EXPECT_EQ(*read_text_file(file), "new");
+    EXPECT_EQ(entries(), (std::vector<std::string>{"file", "link"}));
+
+    // A link to a directory is refused and stays; a dangling one is replaced by the file.
+    fs::create_directory(directory_ / "folder");
+    fs::create_symlink(directory_ / "folder", directory_ / "to_folder");
+    const Status refused = write_file_atomic(directory_ / "to_folder", "x");
+    ASSERT_FALSE(refused);
+    EXPECT_NE(refused.error().message.find("directory"), std::string::npos) << refused.error().to_string();
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(directory_ / "to_folder")));
+    EXPECT_TRUE(fs::is_empty(directory_ / "folder"));
+    fs::create_symlink(directory_ / "nothing", directory_ / "dangling");
+    ASSERT_TRUE(write_file_atomic(directory_ / "dangling", "made"));
+    EXPECT_EQ(*read_text_file(directory_ / "dangling"), "made");
+}
+
+TEST_F(FileTest, TheProcesssOwnStandardOutputIsWrittenThroughItsDescriptor) {
+    // Standard output redirected to a file opened for appending (`>> log`), reached by a link as /dev/stdout
+    // reaches it: the content is appended through descriptor 1, and the file is neither replaced nor
+    // overwritten from its start.
+    const fs::path log = directory_ / "log";
+    std::ofstream(log) << "earlier\n";
+    const fs::path link = directory_ / "stdout";
+    fs::create_symlink(log, link);
+    std::fflush(stdout);
+    const int saved = ::dup(STDOUT_FILENO);
+    ASSERT_GE(saved, 0);
+    const int appended = ::open(log.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    ASSERT_GE(appended, 0);
+    ::dup2(appended, STDOUT_FILENO);
+    ::close(appended);
+    struct stat before {};
+    ::stat(log.c_str(), &before);
+    const Status status = write_file_atomic(link, "later\n");
+    ::dup2(saved, STDOUT_FILENO);  // restored before any check can print
+    ::close(saved);
+    ASSERT_TRUE(status) << status.error().to_string();
+    EXPECT_EQ(*read_text_file(log), "earlier\nlater\n");
+    struct stat after {};
+    ::stat(log.c_str(), &after);
+    EXPECT_EQ(after.st_ino, before.st_ino);  // the same file, not a replacement
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(link)));
+}
+
+TEST_F(FileTest, ANameNearTheLengthLimitStillGetsATemporaryFile) {
+    const fs::path path = directory_ / (std::string(240, 'a') + ".xml");  // 244 bytes: legal, 255 is the limit
+    ASSERT_TRUE(write_file_atomic(path, "content"));
+    EXPECT_EQ(*read_text_file(path), "content");
+    EXPECT_EQ(entries().size(), 1u);
 }
 
 }  // namespace

@@ -19,10 +19,11 @@ namespace hbvh {
 /// the same directory, is flushed to disk (fsync), and is then renamed over `path`. Readers therefore
 /// see either the old file or the complete new one. On any failure the temporary file is removed and
 /// `path` is left as it was. An existing file's permission bits are kept; a new file gets the usual
-/// 0666 & ~umask. A symbolic link to a regular file (or to nothing) at `path` is replaced by the file, not
-/// followed. A path that is, or links to, a device, fifo or socket (`/dev/stdout`, `/dev/null`, a pipe) is
-/// written into directly: a stream cannot be replaced atomically, and renaming over it would replace the device
-/// node or link itself. POSIX only.
+/// 0666 & ~umask. A symbolic link to a regular file is followed: the file it names is replaced and the link
+/// kept (a dangling link is replaced by the file); a link to a directory is refused. Two kinds of path are
+/// written into instead of replaced, since there is nothing there to replace atomically: the process's own
+/// standard output or error, by whatever name (`/dev/stdout`, `/dev/fd/1`, the file the shell redirected it
+/// to), through that descriptor; and a device, fifo or socket (`/dev/null`, a pipe). POSIX only.
 [[nodiscard]] Status write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
 }  // namespace hbvh
