@@ -2,6 +2,7 @@
 // hbvh: builds and queries heterogeneous bounding-volume hierarchies from the command line.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <new>
 
 #include "commands/command.hpp"
 #include "hbvh/io/xml_memory.hpp"
@@ -34,5 +35,23 @@ int main(int argc, char** argv) {
         // --help and --version arrive here too, with exit code 0.
         return app.exit(error) == 0 ? exit_ok : exit_bad_usage;
     }
-    return command ? command() : exit_bad_usage;
+    if (!command) return exit_bad_usage;
+    int code = exit_bad_usage;
+    try {
+        code = command();
+    } catch (const std::bad_alloc&) {
+        // The library returns an Error for every bad input it can see; what it cannot see is how much memory
+        // the machine has (a huge file, or a deep hierarchy exported with every level's primitives).
+        std::fflush(stdout);
+        std::fputs("hbvh: out of memory\n", stderr);
+        return exit_bad_input;
+    }
+    // Whatever a command printed is checked once here: a full disk or a closed pipe behind standard output must
+    // not end in exit 0 (fmt::print and printf buffer, so their errors appear at the flush).
+    // A command that failed has said why already (write_output names a failed write itself).
+    if ((std::fflush(stdout) != 0 || std::ferror(stdout)) && code == exit_ok) {
+        std::fprintf(stderr, "hbvh: cannot write to standard output\n");
+        return exit_bad_input;
+    }
+    return code;
 }

@@ -85,6 +85,21 @@ hbvh_cli_test(directory_input 1 "a_directory.xml: is a directory, not a file" bu
 hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -a no-such-builder -o ${HBVH_CLI_OUT}/x.xml)
 
+# Standard output on a full disk (/dev/full): every command that prints says so and exits 1, whether it writes
+# through -o - or prints a table, and however small its output.
+if(EXISTS /dev/full)
+  foreach(case "build|-a|fast|-o|-" "stats" "convert")
+    string(REPLACE "|" ";" case_args "${case}")
+    list(POP_FRONT case_args subcommand)
+    string(JOIN "|" options ${case_args})
+    add_test(NAME cli.full_stdout.${subcommand}
+             COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli>
+                     "-DARGS=${subcommand}|${PROJECT_SOURCE_DIR}/data/models/chair.xml|${options}" -DEXPECT_EXIT=1
+                     "-DEXPECT_STDERR=cannot write to standard output" -DSTDOUT=/dev/full
+                     -P ${CMAKE_CURRENT_LIST_DIR}/expect.cmake)
+  endforeach()
+endif()
+
 add_test(NAME cli.atomic_output
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
                  -DWORK=${HBVH_CLI_OUT}/atomic -P ${CMAKE_CURRENT_LIST_DIR}/atomic_output.cmake)

@@ -4,22 +4,27 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <filesystem>
 #include <iostream>
 #include <iterator>
+#include <system_error>
 
 #include "commands/command.hpp"
 #include "hbvh/io/file.hpp"
 #include "hbvh/io/model_file.hpp"
+#include "hbvh/tree/binary_format.hpp"
 
 namespace hbvh::cli {
 
 namespace {
 /// Standard input, as survey XML or .hbvh bytes (other formats need a file name: the importers read files).
 Result<ModelFile> read_standard_input(const std::string& format) {
-    if (!format.empty() && format != "xml")
+    if (!format.empty() && format != "xml" && format != "hbvh")
         return Error{"standard input is read as survey XML or .hbvh; --format " + format + " needs a file", "<stdin>"};
     const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+    if (format == "hbvh" && !has_binary_magic(std::as_bytes(std::span(text.data(), text.size()))))
+        return Error{"not an .hbvh file (wrong magic bytes)", "<stdin>"};
     return read_model_bytes(text, "<stdin>");
 }
 
@@ -43,8 +48,10 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
 
 Status write_output(const std::string& path, const std::string& content) {
     if (path == "-") {
-        std::fwrite(content.data(), 1, content.size(), stdout);
-        if (std::fflush(stdout) != 0) return Error{"cannot write to standard output", "-"};
+        errno = 0;
+        const bool written = std::fwrite(content.data(), 1, content.size(), stdout) == content.size();
+        if (!written || std::fflush(stdout) != 0)
+            return Error{"cannot write to standard output" + (errno != 0 ? ": " + std::generic_category().message(errno) : std::string()), "-"};
         return Ok{};
     }
     return write_file_atomic(path, content);
