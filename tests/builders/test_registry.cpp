@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <set>
 #include <string>
 #include <vector>
@@ -94,6 +95,18 @@ TEST(Registry, EveryBuilderHonoursAPassedDeadlineWithAValidTree) {
         test_support::expect_tree_properties(primitives, *built);
         EXPECT_TRUE(report.budget_hit) << row.name << " did not report the passed deadline";
     }
+}
+
+TEST(Registry, TimeLimitsBeyondTheClockOrNotANumberMeanNone) {
+    // Seconds past what the clock's ticks hold (about 292 years) once overflowed into a deadline in the past.
+    const BuildContext none;
+    for (const double seconds : {0.0, -1.0, std::numeric_limits<double>::quiet_NaN(), 1e10, 1e19, 1e308,
+                                 std::numeric_limits<double>::infinity()})
+        EXPECT_FALSE(none.with_time_limit(seconds).has_deadline()) << seconds;
+    const BuildContext day = none.with_time_limit(86400.0);
+    ASSERT_TRUE(day.has_deadline());
+    EXPECT_FALSE(day.expired());
+    EXPECT_NEAR(day.seconds_left(), 86400.0, 60.0);
 }
 
 TEST(Registry, EveryBuilderRefusesBadInputTheSameWay) {

@@ -82,6 +82,8 @@ hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-
 file(MAKE_DIRECTORY ${HBVH_CLI_OUT}/a_directory.xml)
 hbvh_cli_test(directory_input 1 "a_directory.xml: is a directory, not a file" build ${HBVH_CLI_OUT}/a_directory.xml
               -o ${HBVH_CLI_OUT}/directory.out.xml)
+hbvh_cli_test(time_limit_nan 2 "'nan' is not a number of seconds >= 0" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              --time-limit nan -o ${HBVH_CLI_OUT}/x.xml)
 hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -a no-such-builder -o ${HBVH_CLI_OUT}/x.xml)
 

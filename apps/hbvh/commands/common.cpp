@@ -85,7 +85,14 @@ void BuilderFlags::add_to(CLI::App& command) {
         ->check(CLI::IsMember({"eq2", "calibrated"}));
     command.add_option("--time-limit", time_limit_seconds,
                        "Seconds the build may take (0 = no limit); scale and bnb-exact return their best by then")
-        ->check(CLI::NonNegativeNumber);
+        ->check(CLI::Validator(
+            [](const std::string& text) {
+                double seconds = 0.0;
+                return CLI::detail::lexical_cast(text, seconds) && seconds >= 0.0  // NaN fails this too
+                           ? std::string()
+                           : "'" + text + "' is not a number of seconds >= 0 (0: no limit)";
+            },
+            "SECONDS"));
     command.add_flag("--refine", refine,
                      "Refine the builder's tree by optimal treelet re-arrangement (never costlier; docs/treelets.md)");
     command.add_option("--treelet-units", treelet_units,

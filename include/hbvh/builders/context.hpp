@@ -26,12 +26,17 @@ struct BuildContext {
     /// Filled when non-null: per-level rows, notes, lower bound, budget_hit.
     BuildReport* report = nullptr;
 
-    /// A context whose deadline is `seconds` from now (0 or less: none).
+    /// A context whose deadline is `seconds` from now (0 or less, NaN, or beyond what the clock can hold, about
+    /// 292 years: none).
     [[nodiscard]] BuildContext with_time_limit(double seconds) const {
         BuildContext limited = *this;
-        limited.deadline = seconds > 0.0 ? Clock::now() + std::chrono::duration_cast<Clock::duration>(
-                                                              std::chrono::duration<double>(seconds))
-                                         : Clock::time_point::max();
+        const Clock::time_point now = Clock::now();
+        // Converted only when it fits: a cast of more seconds than the clock's ticks hold overflows, and such a
+        // deadline landed in the past (--time-limit 1e10 stopped every builder at once).
+        const double seconds_left_on_clock = std::chrono::duration<double>(Clock::time_point::max() - now).count();
+        limited.deadline = seconds > 0.0 && seconds < 0.5 * seconds_left_on_clock
+                               ? now + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(seconds))
+                               : Clock::time_point::max();
         return limited;
     }
     [[nodiscard]] bool has_deadline() const { return deadline != Clock::time_point::max(); }
