@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstring>
 #include <initializer_list>
+#include <limits>
 #include <mutex>
 #include <utility>
 
@@ -589,6 +590,11 @@ Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const Vol
             return error(line_of(element), "box extents vanish in rounding: they are too small for its position");
         return BoundingVolume(box);
     }
+    // An OBB stores half sizes: a positive size whose half is 0 or subnormal would be a box no writer can give
+    // back (width="0", which this reader refuses) or one the library refuses without naming the line.
+    if ((half.array() < std::numeric_limits<double>::min()).any())
+        return error(line_of(element), "box sizes are too small: half of each must be a normal double (sizes of at "
+                                       "least 4.5e-308)");
     const Result<Mat3> rotation = read_orientation(element, orientation_attribute);
     if (!rotation) return rotation.error();
     return BoundingVolume(Obb{centre, *rotation, half});

@@ -365,6 +365,8 @@ const BadInput bad_inputs[] = {
      2, "'radius' must be > 0"},
     {"zero width", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"0\" depth=\"1\" height=\"1\"/>\n</hierarchy>", 2,
      "'width' must be > 0"},
+    {"rotated box thinner than doubles halve", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"5e-324\" depth=\"1\" height=\"1\"\n    orientation=\"1 0 0 0 0.8 -0.6 0 0.6 0.8\"/>\n</hierarchy>",
+     2, "box sizes are too small: half of each must be a normal double"},
     {"negative depth", H "  <volume type=\"aabb\" pos=\"0 0 0\" width=\"1\" depth=\"-2\" height=\"1\"/>\n</hierarchy>", 2,
      "'depth' must be > 0, found -2"},
     {"negative length", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"1 0 0\" length=\"-1\" radius=\"1\"/>\n</hierarchy>",
