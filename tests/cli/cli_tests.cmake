@@ -158,6 +158,16 @@ set_tests_properties(cli.calibrate PROPERTIES FIXTURES_SETUP calibrated_weights)
 set_tests_properties(cli.type_weight_file PROPERTIES FIXTURES_REQUIRED calibrated_weights)
 hbvh_cli_test(type_weight_file_missing 2 "no-such-weights.txt" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               --type-weight @${HBVH_CLI_OUT}/no-such-weights.txt -o ${HBVH_CLI_OUT}/unweighted_chair.xml)
+# A weights file as an editor may save it (byte order mark, one entry per line, a blank line) is read; a bad entry
+# in it is named with the file.
+string(ASCII 239 187 191 byte_order_mark)
+file(WRITE ${HBVH_CLI_OUT}/edited_weights.txt "${byte_order_mark}aabb=1\n\nobb=1.5\r\ncapsule=1.2\n")
+hbvh_cli_test(type_weight_file_edited 0 "" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a split
+              --type-weight @${HBVH_CLI_OUT}/edited_weights.txt -o ${HBVH_CLI_OUT}/edited_weights_chair.xml)
+file(WRITE ${HBVH_CLI_OUT}/bad_weights.txt "aabb=1\nobb=heavy\n")
+hbvh_cli_test(type_weight_file_bad 2 "bad_weights.txt: type weight 'obb=heavy' needs a positive finite number"
+              build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --type-weight @${HBVH_CLI_OUT}/bad_weights.txt
+              -o ${HBVH_CLI_OUT}/bad_weights_chair.xml)
 
 # --quality: a preset naming the builder (the report says which one ran); it excludes -a, and only its two
 # values are accepted.

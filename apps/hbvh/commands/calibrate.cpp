@@ -88,7 +88,7 @@ int run_calibrate(const CalibrateArguments& args) {
     fmt::print("{:<8} {:>12.2f}   (primitive test, for reference)\n", "leaf", 1e9 * leaf_seconds);
     if (!args.output.empty()) {
         if (Status written = write_output(args.output, weights + "\n"); !written) return report_error(written.error());
-        fmt::print("weights written to {} (use: --type-weight @{})\n", args.output, args.output);
+        if (args.output != "-") fmt::print("weights written to {} (use: --type-weight @{})\n", args.output, args.output);
     }
     return exit_ok;
 }

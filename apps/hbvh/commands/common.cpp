@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <iostream>
 #include <iterator>
+#include <sstream>
 #include <system_error>
 
 #include "commands/command.hpp"
@@ -111,14 +112,21 @@ Result<BuildRequest> BuilderFlags::resolve() const {
     if (!type_weights.empty()) {
         // "@FILE": the weights `hbvh calibrate -o FILE` wrote, in the same type=weight syntax.
         std::string list = type_weights;
+        std::string source;  // the file the weights came from, for errors
         if (list.starts_with('@')) {
-            Result<std::string> text = read_text_file(list.substr(1));
+            source = list.substr(1);
+            if (source.empty()) return Error{"--type-weight @ needs a file name after the @"};
+            Result<std::string> text = read_text_file(source);
             if (!text) return text.error();
             list = *text;
-            while (!list.empty() && std::isspace(static_cast<unsigned char>(list.back()))) list.pop_back();
+            // A byte order mark, and entries on lines or separated by blanks, as an editor may leave them.
+            if (list.starts_with("\xEF\xBB\xBF")) list.erase(0, 3);
+            std::istringstream words(list);
+            list.clear();
+            for (std::string word; words >> word;) list += (list.empty() ? "" : ",") + word;
         }
         policy = parse_type_weights(list, policy.value());
-        if (!policy) return policy.error();
+        if (!policy) return source.empty() ? policy.error() : Error{policy.error().message, source};
     }
     if (objective == "calibrated") policy->measure = NodeMeasure::minkowski;
     BuildRequest request;
