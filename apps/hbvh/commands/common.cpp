@@ -23,7 +23,9 @@ namespace {
 Result<ModelFile> read_standard_input(const std::string& format) {
     if (!format.empty() && format != "xml" && format != "hbvh")
         return Error{"standard input is read as survey XML or .hbvh; --format " + format + " needs a file", "<stdin>"};
-    const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
+    // Read once and kept: `-` means the same bytes each time it is given (`hbvh collide - -`: a model against
+    // itself), where a second read would find standard input used up.
+    static const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
     if (format == "hbvh" && !has_binary_magic(std::as_bytes(std::span(text.data(), text.size()))))
         return Error{"not an .hbvh file (wrong magic bytes)", "<stdin>"};
     return read_model_bytes(text, "<stdin>");
