@@ -55,11 +55,26 @@ std::optional<Algorithm> parse_algorithm(std::string_view name) {
 }
 
 namespace {
-std::string range_message(const Vec3& extent, const char* problem) {
+/// "primitive 7 ('wheel')", or without the parentheses for an unnamed primitive.
+std::string primitive_label(std::span<const Primitive> primitives, std::size_t index) {
+    std::string label = "primitive " + std::to_string(index);
+    if (!primitives[index].name.empty()) label += " ('" + primitives[index].name + "')";
+    return label;
+}
+
+/// The span and the problem, and which two primitives set the widest extent (lowest and highest along that
+/// axis), so that a user can find the stray one in a large file.
+std::string range_message(const Vec3& extent, const char* problem, std::span<const Primitive> primitives,
+                          const std::array<std::size_t, 3>& lowest, const std::array<std::size_t, 3>& highest) {
     char text[200];
     std::snprintf(text, sizeof text, "the primitives span %.3g x %.3g x %.3g: %s", extent.x(), extent.y(),
                   extent.z(), problem);
-    return text;
+    int axis = 0;
+    for (int a = 1; a < 3; ++a)
+        if (!(extent[a] <= extent[axis])) axis = a;  // the widest, an infinite or NaN one first
+    const auto a = static_cast<std::size_t>(axis);
+    return std::string(text) + " (along " + "xyz"[axis] + " from " + primitive_label(primitives, lowest[a]) + " to " +
+           primitive_label(primitives, highest[a]) + ")";
 }
 }  // namespace
 
@@ -70,19 +85,28 @@ std::string range_message(const Vec3& extent, const char* problem) {
 // truly zero), so only a box of three positive extents whose volume is not a normal double is refused.
 Status check_finite_extent(std::span<const Primitive> primitives) {
     Aabb box = Aabb::empty();
+    std::array<std::size_t, 3> lowest{}, highest{};  // which primitive sets each side of the box
     for (std::size_t i = 0; i < primitives.size(); ++i) {
         // Eigen's cwiseMin/cwiseMax may skip a NaN operand, so a NaN box would vanish from the merge.
         const Aabb own = world_aabb(primitives[i].volume);
         if (!own.min.allFinite() || !own.max.allFinite())
-            return Error{"primitive " + std::to_string(i) + " has non-finite coordinates", "", 0};
+            return Error{primitive_label(primitives, i) + " has non-finite coordinates", "", 0};
+        for (int axis = 0; axis < 3; ++axis) {
+            if (own.min[axis] < box.min[axis]) lowest[static_cast<std::size_t>(axis)] = i;
+            if (own.max[axis] > box.max[axis]) highest[static_cast<std::size_t>(axis)] = i;
+        }
         box = box.merged(own);
     }
     const Vec3 extent = box.max - box.min;
     const double volume = 8.0 * extent.x() * extent.y() * extent.z();
     if (!extent.allFinite() || !std::isfinite(volume))
-        return Error{range_message(extent, "volumes overflow double precision; scale the model down"), "", 0};
+        return Error{range_message(extent, "volumes overflow double precision; scale the model down", primitives,
+                                   lowest, highest),
+                     "", 0};
     if ((extent.array() > 0.0).all() && volume < std::numeric_limits<double>::min())
-        return Error{range_message(extent, "volumes underflow double precision; scale the model up"), "", 0};
+        return Error{range_message(extent, "volumes underflow double precision; scale the model up", primitives,
+                                   lowest, highest),
+                     "", 0};
     return Ok{};
 }
 

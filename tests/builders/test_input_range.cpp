@@ -2,6 +2,8 @@
 // build() refuses inputs whose volumes overflow or underflow double precision, and only those.
 #include <gtest/gtest.h>
 
+#include <limits>
+#include <string>
 #include <vector>
 
 #include "hbvh/builders/build.hpp"
@@ -28,6 +30,21 @@ TEST(InputRange, OverflowIsRefusedWithAMessage) {
     // Every builder refuses, the exact ones included (optimal used to run for minutes on such input).
     for (const AlgorithmInfo& info : algorithms())
         EXPECT_FALSE(build(two_spheres(1e120), info.algorithm()).has_value()) << info.name;
+}
+
+TEST(InputRange, TheMessageNamesThePrimitivesThatSetTheWidestExtent) {
+    // Fifty unit spheres and one stray far away: the message leads to the stray by index and name.
+    std::vector<Primitive> primitives;
+    for (int i = 0; i < 50; ++i) primitives.push_back({Sphere{Vec3(i, 0, 0), 1.0}, ""});
+    primitives.insert(primitives.begin() + 31, Primitive{Sphere{Vec3(0, 1e160, -1e200), 1.0}, "stray"});
+    const Status checked = check_finite_extent(primitives);
+    ASSERT_FALSE(checked.has_value());
+    const std::string& message = checked.error().message;
+    EXPECT_NE(message.find("along z from primitive 31 ('stray') to primitive 0"), std::string::npos) << message;
+    primitives[31].volume = Sphere{Vec3(0, std::numeric_limits<double>::infinity(), 0), 1.0};
+    const Status infinite = check_finite_extent(primitives);
+    ASSERT_FALSE(infinite.has_value());
+    EXPECT_EQ(infinite.error().message, "primitive 31 ('stray') has non-finite coordinates");
 }
 
 TEST(InputRange, UnderflowIsRefusedButAFlatModelIsNot) {
