@@ -271,6 +271,17 @@ TEST(Xml, FlatSingleVolumeIsAPrimitiveSet) {
     EXPECT_FALSE(model.hierarchy);
 }
 
+TEST(Xml, ANulByteIsRefusedAtItsLine) {
+    // pugixml would stop at the NUL and accept the document before it.
+    std::string text = "<hierarchy>\n  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"1\"/>\n</hierarchy>\n";
+    text += '\0';
+    text += "<volume";
+    const Result<XmlModel> model = read_xml_string(text, "nul.xml");
+    ASSERT_FALSE(model.has_value());
+    EXPECT_EQ(model.error().line, 4);
+    EXPECT_EQ(model.error().message, "a NUL byte: the file is binary or damaged");
+}
+
 struct BadInput {
     const char* what;
     const char* text;
@@ -365,6 +376,8 @@ const BadInput bad_inputs[] = {
      2, "'radius' must be > 0"},
     {"zero width", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"0\" depth=\"1\" height=\"1\"/>\n</hierarchy>", 2,
      "'width' must be > 0"},
+    {"text after the root", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"1\"/>\n</hierarchy>\ngarbage\n", 3,
+     "text after the end of the document's last tag"},
     {"rotated box thinner than doubles halve", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"5e-324\" depth=\"1\" height=\"1\"\n    orientation=\"1 0 0 0 0.8 -0.6 0 0.6 0.8\"/>\n</hierarchy>",
      2, "box sizes are too small: half of each must be a normal double"},
     {"negative depth", H "  <volume type=\"aabb\" pos=\"0 0 0\" width=\"1\" depth=\"-2\" height=\"1\"/>\n</hierarchy>", 2,
