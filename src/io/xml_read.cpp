@@ -309,12 +309,15 @@ Result<pugi::xml_node> Reader::parse_hierarchy() {
     if (body.starts_with("\xEF\xBB\xBF")) body.remove_prefix(3);  // a UTF-8 byte order mark
     if (is_blank(body)) return error(1, "file is empty");
     // pugixml stops at a NUL byte and drops text after the root element without a word; either means a damaged
-    // or truncated-and-padded file, not a model, so both are refused here.
-    if (const std::size_t nul = text_.find('\0'); nul != std::string::npos)
-        return error(line_at(nul), "a NUL byte: the file is binary or damaged");
+    // or padded file, not a model, so both are refused here. A NUL inside the root ends the parse with an error
+    // of its own, so only what follows the last </hierarchy> is searched (a scan of all 230 MB of a 10^6-primitive
+    // file cost a quarter of its read).
+    const std::size_t root_end = text_.rfind("</hierarchy");
+    if (const std::size_t nul = text_.find('\0', root_end == std::string::npos ? 0 : root_end); nul != std::string::npos)
+        return error(line_at(static_cast<std::ptrdiff_t>(nul)), "a NUL byte: the file is binary or damaged");
     if (const std::size_t last_tag = text_.rfind('>'); last_tag != std::string::npos &&
                                                        !is_blank(std::string_view(text_).substr(last_tag + 1)))
-        return error(line_at(last_tag + 1), "text after the end of the document's last tag");
+        return error(line_at(static_cast<std::ptrdiff_t>(last_tag + 1)), "text after the end of the document's last tag");
     const pugi::xml_parse_result parsed =
         doc_.load_buffer_inplace(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
     if (!parsed) return error(line_at(parsed.offset), describe_parse_error(parsed));
