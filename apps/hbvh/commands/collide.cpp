@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <nlohmann/json.hpp>
+#include <charconv>
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -29,14 +30,13 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
     std::vector<double> numbers;
     std::string word;
     while (stream >> word) {
-        std::size_t used = 0;
+        // from_chars, as the XML reader parses numbers: decimal only (no hex, no locale), and a value too small
+        // for a double reads as out of range rather than failing as "not a number".
         double value = 0.0;
-        try {
-            value = std::stod(word, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != word.size() || !std::isfinite(value))
+        const auto [end, code] = std::from_chars(word.data(), word.data() + word.size(), value);
+        if (code == std::errc::result_out_of_range)
+            return Error{std::string(flag) + ": '" + word + "' is out of the range of double"};
+        if (code != std::errc{} || end != word.data() + word.size() || !std::isfinite(value))
             return Error{std::string(flag) + ": '" + word + "' is not a finite number"};
         numbers.push_back(value);
     }
@@ -44,8 +44,14 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
         return Error{std::string(flag) + " needs 3 numbers (translation) or 7 (translation, then quaternion w x y z)"};
     const Vec3 translation(numbers[0], numbers[1], numbers[2]);
     if (numbers.size() == 3) return RigidTransform{Mat3::Identity(), translation};
-    if (Eigen::Vector4d(numbers[3], numbers[4], numbers[5], numbers[6]).norm() < 1e-12)
-        return Error{std::string(flag) + ": the quaternion is zero"};
+    // The quaternion's scale does not matter (it is normalised): bring it near 1 first, so that 1e300 and 1e-300
+    // components neither overflow nor vanish in the norm.
+    Eigen::Vector4d quaternion(numbers[3], numbers[4], numbers[5], numbers[6]);
+    const double largest = quaternion.cwiseAbs().maxCoeff();
+    if (!(largest > 0.0)) return Error{std::string(flag) + ": the quaternion is zero"};
+    quaternion /= largest;
+    if (quaternion.norm() < 1e-12) return Error{std::string(flag) + ": the quaternion is zero"};
+    numbers[3] = quaternion[0], numbers[4] = quaternion[1], numbers[5] = quaternion[2], numbers[6] = quaternion[3];
     const RigidTransform pose = RigidTransform::from_quaternion(numbers[3], numbers[4], numbers[5], numbers[6], translation);
     if (Status valid = validate_pose(pose); !valid) return Error{std::string(flag) + ": " + valid.error().message};
     return pose;
