@@ -84,6 +84,9 @@ hbvh_cli_test(directory_input 1 "a_directory.xml: is a directory, not a file" bu
               -o ${HBVH_CLI_OUT}/directory.out.xml)
 hbvh_cli_test(time_limit_nan 2 "'nan' is not a number of seconds >= 0" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               --time-limit nan -o ${HBVH_CLI_OUT}/x.xml)
+hbvh_cli_test(seed_negative 2 "'-1' is not a whole number" generate --count 2 --seed -1)
+hbvh_cli_test(seed_too_large 2 "'18446744073709551616' is not a whole number" generate --count 2
+              --seed 18446744073709551616)
 hbvh_cli_test(unknown_algorithm 2 "no-such-builder" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -a no-such-builder -o ${HBVH_CLI_OUT}/x.xml)
 

@@ -50,6 +50,9 @@ struct Model : ModelFile {
 int report_error(const Error& error);
 /// Prints warnings to stderr, one a line.
 void report_warnings(const std::vector<std::string>& warnings);
+/// Refuses what is not a decimal integer from 0 to 2^64 - 1 (CLI11 alone wraps "-1" and clamps larger values, so
+/// different seeds on the command line gave the same scene).
+[[nodiscard]] CLI::Validator seed_validator();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.
 struct BuildRequest {

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
+#include <cstdint>
 #include <cerrno>
 #include <filesystem>
 #include <iostream>
@@ -58,6 +60,18 @@ Status write_output(const std::string& path, const std::string& content) {
         return Ok{};
     }
     return write_file_atomic(path, content);
+}
+
+CLI::Validator seed_validator() {
+    return CLI::Validator(
+        [](const std::string& text) {
+            std::uint64_t value = 0;
+            const auto [end, code] = std::from_chars(text.data(), text.data() + text.size(), value);
+            return code == std::errc{} && end == text.data() + text.size()
+                       ? std::string()
+                       : "'" + text + "' is not a whole number from 0 to 18446744073709551615";
+        },
+        "SEED");
 }
 
 int report_error(const Error& error) {
