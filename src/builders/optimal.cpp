@@ -150,6 +150,7 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildCont
         Result<Bvh> fallback = build_bnb_exact(primitives, context);
         if (fallback && context.report != nullptr) {
             context.report->lower_bound = 0.0;
+            context.report->built_by = "bnb-exact";
             context.report->notes.push_back("optimal: " + std::to_string(primitives.size()) +
                                             " primitives exceed the limit of " + std::to_string(limit) +
                                             "; built bnb-exact instead (not proven optimal)");

@@ -170,6 +170,10 @@ TEST(OptimalHierarchy, RefusesOrFallsBackAboveTheLimitAndHandlesOnePrimitive) {
     EXPECT_TRUE(validate(*fallback).has_value());
     EXPECT_EQ(report.lower_bound, 0.0);
     EXPECT_FALSE(report.notes.empty());
+    EXPECT_EQ(report.built_by, "bnb-exact");
+    BuildReport within;
+    ASSERT_TRUE(build_optimal(few, test_support::context_for(VolumePolicy::all(), &within)).has_value());
+    EXPECT_EQ(within.built_by, "");  // the DP's own tree
     EXPECT_FALSE(build_optimal(std::span<const Primitive>{}, test_support::context_for(VolumePolicy::all())).has_value());
     const auto one = generate_scene({.count = 1, .seed = 1});
     const Result<Bvh> leaf = build_optimal(one, test_support::context_for(VolumePolicy::all()));

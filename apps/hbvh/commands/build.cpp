@@ -98,7 +98,10 @@ int run_build(const BuildArguments& args) {
         if (args.report) print_report(report, seconds, stats.cost);
         if (args.stats)
             fmt::print(stderr, "{}: {} primitives, {} nodes, height {}, cost {:.6g} ({} in {:.3f} ms); {}\n", args.input,
-                       stats.leaves, stats.nodes, stats.height, stats.cost, to_string(algorithm), 1e3 * seconds,
+                       stats.leaves, stats.nodes, stats.height, stats.cost,
+                       report.built_by.empty() ? std::string(to_string(algorithm))
+                                               : std::string(to_string(algorithm)) + ", built by " + report.built_by,
+                       1e3 * seconds,
                        bound_summary(report, stats.cost));
     }
     // -o NAME.hbvh writes the binary format, anything else the survey XML.

@@ -25,6 +25,9 @@ struct BuildReport {
     bool budget_hit = false;            ///< Any level hit its budget.
     double lower_bound = 0.0;           ///< Proven lower bound on the cost, where the builder knows one (else 0).
     std::vector<std::string> notes;     ///< Free-form remarks (fallbacks, choices made by `auto`).
+    /// The registry name of the builder whose tree was returned when it is not the one asked for (`optimal`
+    /// above its primitive limit returns bnb-exact's); empty otherwise.
+    std::string built_by;
 };
 
 }  // namespace hbvh
