@@ -71,7 +71,8 @@ Status write_into_stream(const std::filesystem::path& path, std::string_view con
     } while (fd < 0 && errno == EINTR);
     if (fd < 0) return Error("cannot open for writing: " + describe(errno), name);
     FileDescriptor stream(fd);
-    if (const int code = write_all(stream.get(), content); code != 0) return Error("cannot write: " + describe(code), name);
+    if (const int code = write_all(stream.get(), content); code != 0)
+        return Error("cannot write: " + describe(code), name);
     if (const int code = stream.close_checked(); code != 0) return Error("cannot write: " + describe(code), name);
     return Ok{};
 }

@@ -317,7 +317,8 @@ Result<pugi::xml_node> Reader::parse_hierarchy() {
         return error(line_at(static_cast<std::ptrdiff_t>(nul)), "a NUL byte: the file is binary or damaged");
     if (const std::size_t last_tag = text_.rfind('>'); last_tag != std::string::npos &&
                                                        !is_blank(std::string_view(text_).substr(last_tag + 1)))
-        return error(line_at(static_cast<std::ptrdiff_t>(last_tag + 1)), "text after the end of the document's last tag");
+        return error(line_at(static_cast<std::ptrdiff_t>(last_tag + 1)),
+                     "text after the end of the document's last tag");
     const pugi::xml_parse_result parsed =
         doc_.load_buffer_inplace(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
     if (!parsed) return error(line_at(parsed.offset), describe_parse_error(parsed));

@@ -149,7 +149,8 @@ hbvh_cli_bad_pose(inf --pose-a "0 inf 0" ": 'inf' is not a finite number")
 hbvh_cli_bad_pose(inf_quaternion --pose-b "0 0 0 1 -inf 0 0" ": '-inf' is not a finite number")
 hbvh_cli_bad_pose(overflow --pose-b "1e999 0 0" ": '1e999' is out of the range of double")
 hbvh_cli_bad_pose(hex --pose-b "0x1 0 0" ": '0x1' is not a finite number")
-hbvh_cli_test(collide.pose.large_quaternion 0 "" collide ${HBVH_CLI_PAIRS} ${HBVH_CLI_PAIRS} --pose-b "0 0 0 0 1e300 1e300 0")
+hbvh_cli_test(collide.pose.large_quaternion 0 "" collide ${HBVH_CLI_PAIRS} ${HBVH_CLI_PAIRS}
+              --pose-b "0 0 0 0 1e300 1e300 0")
 hbvh_cli_bad_pose(not_a_number --pose-a "0 0 x" ": 'x' is not a finite number")
 hbvh_cli_bad_pose(trailing_garbage --pose-b "0 0 1m" ": '1m' is not a finite number")
 # An empty pose given is refused like any other that does not parse (it once meant the identity); the

@@ -4,9 +4,9 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
 #include <charconv>
 #include <cstdint>
-#include <cerrno>
 #include <filesystem>
 #include <iostream>
 #include <iterator>
@@ -55,8 +55,10 @@ Status write_output(const std::string& path, const std::string& content) {
     if (path == "-") {
         errno = 0;
         const bool written = std::fwrite(content.data(), 1, content.size(), stdout) == content.size();
-        if (!written || std::fflush(stdout) != 0)
-            return Error{"cannot write to standard output" + (errno != 0 ? ": " + std::generic_category().message(errno) : std::string()), "-"};
+        if (!written || std::fflush(stdout) != 0) {
+            const std::string reason = errno != 0 ? ": " + std::generic_category().message(errno) : std::string();
+            return Error{"cannot write to standard output" + reason, "-"};
+        }
         return Ok{};
     }
     return write_file_atomic(path, content);

@@ -61,7 +61,9 @@ void add_simulate_command(CLI::App& app, Command& command) {
     sub->add_option("--collisions", args->options.collision_count, "Root-overlapping queries to measure")
         ->capture_default_str()
         ->check(CLI::Range(1u, 10000000u));
-    sub->add_option("--seed", args->options.seed, "Seed of the start states")->capture_default_str()->check(seed_validator());
+    sub->add_option("--seed", args->options.seed, "Seed of the start states")
+        ->capture_default_str()
+        ->check(seed_validator());
     sub->add_flag("--two-level-query", args->two_level_query, "Query with the Two-Level method (root, then all pairs)");
     sub->add_flag("--json", args->json, "Print JSON");
     sub->footer("Example: hbvh simulate data/models/chair.xml --collisions 1000 --json");
