@@ -79,8 +79,8 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         options.one_primitive_per_mesh = true;
         return from_import(import_mesh(path, options), path);
     }
-    // The survey format keeps a stored hierarchy; the importers give primitives only.
     if (format == "hbvh") return from_binary(read_binary_file(path));
+    // The survey format keeps a stored hierarchy; the importers give primitives only.
     static const std::pair<std::string_view, ImportFormat> formats[] = {
         {"", ImportFormat::automatic}, {"xml", ImportFormat::survey_xml}, {"mjcf", ImportFormat::mjcf},
         {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
