@@ -61,14 +61,20 @@ ssize_t read_some(int fd, char* data, std::size_t size) {
     }
 }
 
+/// open(), resumed after signals (a fifo's open blocks until the other end opens, long enough to be interrupted):
+/// the descriptor, or -1 with errno set.
+int open_retrying(const std::filesystem::path& path, int flags) {
+    for (;;) {
+        const int fd = ::open(path.c_str(), flags);
+        if (fd >= 0 || errno != EINTR) return fd;
+    }
+}
+
 /// Writes `content` into the existing non-regular file at `path` (a device, fifo or socket), without truncating
 /// or replacing it.
 Status write_into_stream(const std::filesystem::path& path, std::string_view content) {
     const std::string name = path.string();
-    int fd = -1;
-    do {
-        fd = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
-    } while (fd < 0 && errno == EINTR);
+    const int fd = open_retrying(path, O_WRONLY | O_CLOEXEC);
     if (fd < 0) return Error("cannot open for writing: " + describe(errno), name);
     FileDescriptor stream(fd);
     if (const int code = write_all(stream.get(), content); code != 0)
@@ -103,10 +109,7 @@ std::filesystem::path temporary_name(const std::filesystem::path& target, unsign
 
 Result<std::string> read_text_file(const std::filesystem::path& path) {
     const std::string name = path.string();
-    int fd = -1;
-    do {
-        fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-    } while (fd < 0 && errno == EINTR);
+    const int fd = open_retrying(path, O_RDONLY | O_CLOEXEC);
     if (fd < 0) return Error("cannot open for reading: " + describe(errno), name);
     FileDescriptor file(fd);
 
