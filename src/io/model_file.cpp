@@ -98,28 +98,23 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
     // A name that tells nothing (a pipe such as /dev/stdin or <(...), a file without an extension) is read once
     // and decided by its bytes, for the two formats read from bytes: .hbvh and survey XML. The importers take
     // paths (MJCF's includes, meshes' textures), so for those --format must name the format.
-    if (automatic && !detail::is_import_extension(extension)) {
-        Result<std::string> bytes = read_text_file(path);
-        if (!bytes) return bytes.error();
-        const std::span<const std::byte> raw = std::as_bytes(std::span(bytes.value()));
-        if (has_binary_magic(raw)) return from_binary(read_binary(raw, path));
-        if (bytes->find("<hierarchy") != std::string::npos)
-            return from_xml(detail::read_xml_taking(std::move(bytes).value(), path));
-        return Error{"unknown file type '" + extension +
-                         "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format "
-                         "(hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
-                         ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
-                     path};
-    }
-    if (chosen->second == ImportFormat::survey_xml || (automatic && extension == ".xml")) {
+    const bool by_bytes = automatic && !detail::is_import_extension(extension);
+    if (chosen->second == ImportFormat::survey_xml || (automatic && extension == ".xml") || by_bytes) {
         Result<std::string> text = read_text_file(path);
         if (!text) return text.error();
-        // An .xml whose root is <mujoco> is MJCF (the importer below takes it), unless the format says otherwise.
         const std::span<const std::byte> raw = std::as_bytes(std::span(text.value()));
         if (has_binary_magic(raw)) return from_binary(read_binary(raw, path));
+        // An .xml whose root is <mujoco> is MJCF (the importer below takes it), unless the format says otherwise.
+        const bool survey = !automatic || (by_bytes ? text->find("<hierarchy") != std::string::npos
+                                                    : text->find("<mujoco") == std::string::npos);
         // The XML reader takes the text over: a 230 MB file is parsed where it was read, not copied.
-        if (!automatic || text->find("<mujoco") == std::string::npos)
-            return from_xml(detail::read_xml_taking(std::move(text).value(), path));
+        if (survey) return from_xml(detail::read_xml_taking(std::move(text).value(), path));
+        if (by_bytes)
+            return Error{"unknown file type '" + extension +
+                             "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format "
+                             "(hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
+                             ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
+                         path};
     }
     return from_import(import_primitives(path, chosen->second), path);
 }
