@@ -1,10 +1,12 @@
 // SPDX-License-Identifier: MIT
 // The speed preset: build_fast's time per build and its tree's Eq. 2 cost relative to auto's, without the quick
 // treelet sweep and with 4-6 units per treelet (FastOptions::treelet_units), and for 0, 2, 4 and 8 refitted
-// nodes (FastOptions::exact_fits), on the bundled models and generated objects of 30 primitives. The defaults
-// (5 units, 2 refits) are chosen from this table and the peers' objects (docs/fast.md).
+// nodes (FastOptions::exact_fits), with and without the root's look-ahead (FastOptions::lookahead_candidates), on the
+// bundled models and generated objects of 30 primitives. The defaults (5 units, 2 refits, 8 candidates) are chosen
+// from this table and the peers' objects (docs/fast.md).
 #include <benchmark/benchmark.h>
 
+#include <array>
 #include <filesystem>
 #include <map>
 #include <string>
@@ -64,16 +66,24 @@ void fast_build(benchmark::State& state, const std::string& name, const FastOpti
     state.counters["cost_vs_auto"] = tree_cost / object.auto_cost;
 }
 
-/// Rows FastBuild/NAME/treelets:U/refits:R: U units per quick treelet (0: no sweep), R refitted nodes.
+/// Rows FastBuild/NAME/treelets:U/refits:R/lookahead:L: U units per quick treelet (0: no sweep), R refitted nodes,
+/// L candidate cuts of the root's look-ahead (0: the greedy cut).
 void register_fast_benchmarks() {
-    constexpr std::uint32_t default_units = FastOptions{}.treelet_units;
-    const std::pair<std::uint32_t, std::uint32_t> settings[] = {{0, 2}, {4, 2}, {default_units, 0}, {default_units, 2},
-                                                                {default_units, 4}, {default_units, 8}, {6, 2}};
+    constexpr FastOptions defaults;
+    const std::uint32_t units = defaults.treelet_units, refits = defaults.exact_fits, lookahead = defaults.lookahead_candidates;
+    const std::array<std::array<std::uint32_t, 3>, 8> settings{{{0, refits, lookahead},
+                                                                {4, refits, lookahead},
+                                                                {units, 0, lookahead},
+                                                                {units, refits, lookahead},
+                                                                {units, 4, lookahead},
+                                                                {units, 8, lookahead},
+                                                                {6, refits, lookahead},
+                                                                {units, refits, 0}}};
     for (const char* name : object_names)
-        for (const auto& [units, refits] : settings) {
-            const FastOptions options{.treelet_units = units, .exact_fits = refits};
-            benchmark::RegisterBenchmark(("FastBuild/" + std::string(name) + "/treelets:" + std::to_string(units) +
-                                          "/refits:" + std::to_string(refits))
+        for (const auto& [treelet_units, exact_fits, candidates] : settings) {
+            const FastOptions options{.treelet_units = treelet_units, .exact_fits = exact_fits, .lookahead_candidates = candidates};
+            benchmark::RegisterBenchmark(("FastBuild/" + std::string(name) + "/treelets:" + std::to_string(treelet_units) +
+                                          "/refits:" + std::to_string(exact_fits) + "/lookahead:" + std::to_string(candidates))
                                              .c_str(),
                                          [name = std::string(name), options](benchmark::State& state) {
                                              fast_build(state, name, options);

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <limits>
 #include <optional>
+#include <tuple>
 #include <vector>
 
 #include "guarded_build.hpp"
@@ -37,6 +38,8 @@ constexpr std::uint32_t max_children_limit = 16;
 using CollapseCosts = std::array<double, max_children_limit + 1>;
 /// Ranges up to this size are swept with per-side fits (estimate_sweep_cut) in small inputs, as split does.
 constexpr std::size_t estimate_sweep_max_primitives = 64;
+/// Ranges up to this size may look ahead (BinnedOptions::lookahead_depth): each trial plans the whole range.
+constexpr std::size_t lookahead_max_primitives = 64;
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
 double box_area(const Aabb& box) {
@@ -49,7 +52,17 @@ double box_area(const Aabb& box) {
 /// log2 m levels adds twice the volume it covers), and a single primitive adds nothing of its own. This
 /// weighting made trees 2-3 % cheaper than the count weighting of ray-tracing's surface area heuristic
 /// (count x area), which assumes a cost per primitive in each leaf (docs/scale.md §9).
-double side_weight(double count) { return 2.0 * std::log2(count); }
+double side_weight(double count) {
+    // Small counts from a table: the sweeps of small ranges price every cut, and log2 was 5 % of a small build.
+    static const std::array<double, 65> small = [] {
+        std::array<double, 65> weights{};
+        for (std::size_t i = 1; i < weights.size(); ++i) weights[i] = 2.0 * std::log2(static_cast<double>(i));
+        return weights;
+    }();
+    if (count >= 1.0 && count < static_cast<double>(small.size()) && count == std::floor(count))
+        return small[static_cast<std::size_t>(count)];
+    return 2.0 * std::log2(count);
+}
 
 /// A cut's expected Eq. 2, with the boxes' surface as the tie-breaker: flat scenes (every box of zero volume)
 /// are then still cut where the sides are smallest.
@@ -195,7 +208,8 @@ private:
             return leaf;
         }
         checkpoint_.step(progress_offset_ + static_cast<double>(placed_.load(std::memory_order_relaxed)));
-        const std::uint32_t cut = begin + choose_cut(std::span(refs_.data() + begin, end - begin), depth);
+        const std::span<Ref> range(refs_.data() + begin, end - begin);
+        const std::uint32_t cut = begin + (looks_ahead(range.size(), depth) ? lookahead_cut(range, depth) : choose_cut(range, depth));
         Planned left, right;
         constexpr std::uint32_t parallel_above = 4096;  // below, a task costs more than the range
         if (end - begin > parallel_above)
@@ -205,6 +219,189 @@ private:
         const auto slot = static_cast<std::uint32_t>(refs_.size()) - 1 + cut;
         nodes_[slot] = BinaryNode{nodes_[left.slot].box.merged(nodes_[right.slot].box), left.slot, right.slot, begin, end, false};
         return {slot, collapse_costs(slot, left.costs, right.costs)};
+    }
+
+    /// plan()'s subtree over a range, priced without building it: its collapse costs, with every cut chosen as
+    /// choose_cut would choose it, found on lists of the range's positions sorted once along each axis instead of
+    /// on refs re-sorted at every level. The look-ahead's trials (lookahead_cut).
+    class SweptTrial {
+    public:
+        SweptTrial(const BinnedBuilder& builder, std::span<const Ref> range) : builder_(builder), range_(range) {
+            const auto size = static_cast<std::uint32_t>(range.size());
+            for (int axis = 0; axis < 3; ++axis) {
+                std::vector<std::uint32_t>& list = sorted_[axis];
+                list.resize(size);
+                for (std::uint32_t i = 0; i < size; ++i) list[i] = i;
+                std::sort(list.begin(), list.end(), [&](std::uint32_t a, std::uint32_t b) {
+                    const double ca = range[a].centre[axis], cb = range[b].centre[axis];
+                    return ca != cb ? ca < cb : range[a].local < range[b].local;
+                });
+            }
+            side_.resize(size);
+            scratch_.resize(size);
+            right_sides_.resize(size);
+        }
+
+        /// Every cut of the whole range priced as sweep_cut prices it: (cost, axis, left count), in sweep order.
+        /// The left side of a cut is the first `left count` refs sorted along its axis.
+        [[nodiscard]] std::vector<std::tuple<CutCost, int, std::uint32_t>> root_cuts() {
+            std::vector<std::tuple<CutCost, int, std::uint32_t>> cuts;
+            for (int axis = 0; axis < 3; ++axis)
+                sweep(std::span(sorted_[axis]), [&](std::uint32_t left, const CutCost& cost) { cuts.emplace_back(cost, axis, left); });
+            return cuts;
+        }
+
+        /// choose_cut's cut of the whole range at `depth`.
+        [[nodiscard]] std::pair<int, std::uint32_t> greedy_cut(std::uint32_t depth) {
+            return choice({std::span(sorted_[0]), std::span(sorted_[1]), std::span(sorted_[2])}, depth);
+        }
+
+        /// The least Eq. 2 cost of the range's subtree when its root is kept (collapse_costs' entry 1, the root's
+        /// own term included) if it is cut along `axis` before `left`, each side planned as plan() plans it.
+        [[nodiscard]] double kept_cost(int axis, std::uint32_t left, std::uint32_t depth) {
+            std::array<std::vector<std::uint32_t>, 3> lists = sorted_;
+            std::array<std::span<std::uint32_t>, 3> spans{std::span(lists[0]), std::span(lists[1]), std::span(lists[2])};
+            const auto [left_costs, right_costs] = cut_and_plan(spans, axis, left, depth + 1);
+            Aabb whole = Aabb::empty();
+            for (const Ref& ref : range_) whole = whole.merged(ref.box);
+            return builder_.combine(left_costs, right_costs, whole, nullptr)[1];
+        }
+
+    private:
+        /// Calls visit(left count, cost) for every cut of `list` (positions sorted along one axis).
+        template <class Visit>
+        void sweep(std::span<const std::uint32_t> list, Visit&& visit) {
+            const std::size_t count = list.size();
+            Aabb running = Aabb::empty();
+            for (std::size_t i = count; i-- > 0;) right_sides_[i] = running = running.merged(range_[list[i]].box);
+            running = Aabb::empty();
+            for (std::size_t left = 1; left < count; ++left) {
+                running = running.merged(range_[list[left - 1]].box);
+                visit(static_cast<std::uint32_t>(left),
+                      builder_.cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides_[left]));
+            }
+        }
+
+        /// The collapse costs of the sub-range whose positions are in `lists` (one list per axis, each sorted).
+        CollapseCosts plan_costs(std::array<std::span<std::uint32_t>, 3> lists, std::uint32_t depth) {
+            const std::size_t count = lists[0].size();
+            if (count == 1) {
+                CollapseCosts leaf;
+                leaf.fill(infinity);
+                leaf[1] = 0.0;
+                return leaf;
+            }
+            const auto [best_axis, best_left] = choice(lists, depth);
+            Aabb whole = Aabb::empty();
+            for (const std::uint32_t i : lists[0]) whole = whole.merged(range_[i].box);
+            const auto [left_costs, right_costs] = cut_and_plan(lists, best_axis, best_left, depth + 1);
+            return builder_.combine(left_costs, right_costs, whole, nullptr);
+        }
+
+        /// choose_cut's choice for the sub-range in `lists`, as (axis, left count): median_cut beyond the depth
+        /// limit, sweep_cut up to sweep_max_primitives, else binned_cut, else median_cut (estimate sweeps are off
+        /// where looks_ahead allows a look-ahead).
+        [[nodiscard]] std::pair<int, std::uint32_t> choice(const std::array<std::span<std::uint32_t>, 3>& lists,
+                                                           std::uint32_t depth) {
+            const std::size_t count = lists[0].size();
+            if (depth < builder_.depth_limit_ && count <= builder_.options_.sweep_max_primitives) {
+                CutCost best;
+                std::pair<int, std::uint32_t> chosen{0, static_cast<std::uint32_t>(count / 2)};
+                for (int axis = 0; axis < 3; ++axis)
+                    sweep(lists[static_cast<std::size_t>(axis)], [&](std::uint32_t left, const CutCost& cost) {
+                        if (cost < best) best = cost, chosen = {axis, left};  // ties: the earlier axis and cut
+                    });
+                return chosen;
+            }
+            if (depth < builder_.depth_limit_) {
+                const BinnedChoice bins = builder_.binned_choice([&](auto&& visit) {
+                    for (const std::uint32_t i : lists[0]) visit(range_[i]);
+                });
+                if (bins.axis != 3) {
+                    std::uint32_t left = 0;
+                    for (const std::uint32_t i : lists[0]) left += bins.left_of(range_[i]) ? 1u : 0u;
+                    return {static_cast<int>(bins.axis), left};
+                }
+            }
+            // median_cut: the lower half along the centres' longest extent.
+            Vec3 extent;
+            for (int axis = 0; axis < 3; ++axis)
+                extent[axis] = range_[lists[static_cast<std::size_t>(axis)].back()].centre[axis] -
+                               range_[lists[static_cast<std::size_t>(axis)].front()].centre[axis];
+            int axis = 0;
+            extent.maxCoeff(&axis);
+            return {axis, static_cast<std::uint32_t>(count / 2)};
+        }
+
+        /// Splits every list into the first `left` positions along `axis` and the rest, each part keeping its
+        /// order, and plans both parts.
+        std::pair<CollapseCosts, CollapseCosts> cut_and_plan(std::array<std::span<std::uint32_t>, 3> lists, int axis,
+                                                             std::uint32_t left, std::uint32_t depth) {
+            const std::size_t count = lists[0].size();
+            for (std::size_t i = 0; i < count; ++i) side_[lists[static_cast<std::size_t>(axis)][i]] = i < left;
+            for (std::span<std::uint32_t> list : lists) {
+                std::size_t l = 0, r = left;
+                for (const std::uint32_t i : list) scratch_[side_[i] ? l++ : r++] = i;
+                std::copy(scratch_.begin(), scratch_.begin() + static_cast<std::ptrdiff_t>(count), list.begin());
+            }
+            const CollapseCosts left_costs =
+                plan_costs({lists[0].first(left), lists[1].first(left), lists[2].first(left)}, depth);
+            const CollapseCosts right_costs =
+                plan_costs({lists[0].subspan(left), lists[1].subspan(left), lists[2].subspan(left)}, depth);
+            return {left_costs, right_costs};
+        }
+
+        const BinnedBuilder& builder_;
+        std::span<const Ref> range_;
+        std::array<std::vector<std::uint32_t>, 3> sorted_;
+        std::vector<std::uint8_t> side_;
+        std::vector<std::uint32_t> scratch_;
+        std::vector<Aabb> right_sides_;
+    };
+
+    /// Whether plan() looks ahead at a range: near the top of small inputs, where one greedy cut decides the
+    /// shape of the whole tree, and only where no estimate sweep is made below (SweptTrial reproduces the others).
+    [[nodiscard]] bool looks_ahead(std::size_t size, std::uint32_t depth) const {
+        return depth < options_.lookahead_depth && options_.lookahead_candidates > 0 &&
+               refs_.size() > options_.estimate_sweep_up_to && size <= lookahead_max_primitives && size > 2 &&
+               depth < depth_limit_;
+    }
+
+    /// The cut whose two sides, each planned greedily below, give the range the least collapsed box cost (the
+    /// cost plan() will compute for it), among choose_cut's own (so the range's box cost is never above the
+    /// greedy cut's) and the `lookahead_candidates` cheapest local minima of sweep_cut's price along each axis.
+    /// The range is left sorted for it. On the Tie-Interceptor the greedy cut groups the blade tips and cannons
+    /// of both wings, which no later re-arrangement undoes; a trial costs a few microseconds at 40 primitives
+    /// (docs/fast.md).
+    std::uint32_t lookahead_cut(std::span<Ref> range, std::uint32_t depth) const {
+        SweptTrial trial(*this, range);
+        // The candidates are the local minima of the price along each axis's sweep, cheapest first: the cuts
+        // next to a minimum (one primitive more or fewer on a side) make nearly the same tree, and trials of the
+        // eight cheapest cuts overall found less than trials of the six cheapest minima (docs/fast.md).
+        const std::vector<std::tuple<CutCost, int, std::uint32_t>> priced = trial.root_cuts();
+        std::vector<std::tuple<CutCost, int, std::uint32_t>> minima;
+        for (std::size_t i = 0; i < priced.size(); ++i) {
+            const auto& [price, axis, left] = priced[i];
+            const bool first_of_axis = i == 0 || std::get<1>(priced[i - 1]) != axis;
+            const bool last_of_axis = i + 1 == priced.size() || std::get<1>(priced[i + 1]) != axis;
+            if ((first_of_axis || !(std::get<0>(priced[i - 1]) < price)) && (last_of_axis || price < std::get<0>(priced[i + 1])))
+                minima.push_back(priced[i]);
+        }
+        // Ties: the sweep's order (the earlier axis and cut), as sweep_cut breaks them.
+        std::stable_sort(minima.begin(), minima.end(), [](const auto& a, const auto& b) { return std::get<0>(a) < std::get<0>(b); });
+        std::vector<std::pair<int, std::uint32_t>> candidates{trial.greedy_cut(depth)};
+        for (std::size_t i = 0; i < minima.size() && candidates.size() <= options_.lookahead_candidates; ++i) {
+            const std::pair<int, std::uint32_t> cut{std::get<1>(minima[i]), std::get<2>(minima[i])};
+            if (cut != candidates.front()) candidates.push_back(cut);
+        }
+        double best = infinity;
+        std::pair<int, std::uint32_t> chosen = candidates.front();
+        for (const auto& [axis, left] : candidates) {
+            const double kept = trial.kept_cost(axis, left, depth);
+            if (kept < best) best = kept, chosen = {axis, left};
+        }
+        sort_along(range, chosen.first);
+        return chosen.second;
     }
 
     /// Reorders `range` so that the cut falls before the returned position (0 < cut < size).
@@ -269,35 +466,60 @@ private:
     /// The best boundary between `bin_count` equal bins of the centres' extent on any axis, with the range
     /// partitioned there; 0 when the centres fall into one bin on every axis.
     std::uint32_t binned_cut(std::span<Ref> range) const {
+        const BinnedChoice choice = binned_choice([&](auto&& visit) {
+            for (const Ref& ref : range) visit(ref);
+        });
+        if (choice.axis == 3) return 0;
+        // std::partition's result depends only on the range's contents and order, never on threads.
+        const auto middle = std::partition(range.begin(), range.end(), [&](const Ref& ref) { return choice.left_of(ref); });
+        return static_cast<std::uint32_t>(middle - range.begin());
+    }
+
+    /// binned_cut's choice: the axis (3 when the centres fall into one bin on every axis) and the boundary between
+    /// bins, with what it takes to say on which side a ref falls. A ref's bin grows with its centre's coordinate,
+    /// so the left side is a prefix of the refs sorted along the axis.
+    struct BinnedChoice {
+        std::size_t axis = 3;
+        std::uint32_t boundary = 0;
+        std::uint32_t bins = 0;
+        Vec3 low = Vec3::Zero();
+        std::array<double, 3> scale{};
+        [[nodiscard]] std::uint32_t bin_index(const Ref& ref, std::size_t along) const {
+            const auto a = static_cast<Eigen::Index>(along);
+            const double at = (ref.centre[a] - low[a]) * scale[along];
+            if (!(at > 0.0)) return 0u;  // NaN too: 0 x inf, a centre at the minimum of a denormal extent
+            return static_cast<std::uint32_t>(std::min(at, static_cast<double>(bins - 1)));
+        }
+        [[nodiscard]] bool left_of(const Ref& ref) const { return bin_index(ref, axis) < boundary; }
+    };
+
+    /// binned_cut's choice over the refs that `for_each(visit)` visits.
+    template <class ForEach>
+    BinnedChoice binned_choice(ForEach&& for_each) const {
         Aabb centres = Aabb::empty();
-        for (const Ref& ref : range) centres = centres.merged({ref.centre, ref.centre});
-        const std::uint32_t bins = std::clamp(options_.bin_count, 2u, 256u);
+        for_each([&](const Ref& ref) { centres = centres.merged({ref.centre, ref.centre}); });
+        BinnedChoice choice;
+        const std::uint32_t bins = choice.bins = std::clamp(options_.bin_count, 2u, 256u);
+        choice.low = centres.min;
         struct Bin {
             Aabb box = Aabb::empty();
             double count = 0;
         };
         std::vector<Bin> bin(3 * std::size_t{bins});
-        std::array<double, 3> scale{};
+        std::array<double, 3>& scale = choice.scale;
         for (std::size_t axis = 0; axis < 3; ++axis) {
             const double extent = centres.max[static_cast<Eigen::Index>(axis)] - centres.min[static_cast<Eigen::Index>(axis)];
             scale[axis] = extent > 0.0 ? static_cast<double>(bins) / extent : 0.0;
         }
-        auto bin_index = [&](const Ref& ref, std::size_t axis) {
-            const auto a = static_cast<Eigen::Index>(axis);
-            const double at = (ref.centre[a] - centres.min[a]) * scale[axis];
-            if (!(at > 0.0)) return 0u;  // NaN too: 0 x inf, a centre at the minimum of a denormal extent
-            return static_cast<std::uint32_t>(std::min(at, static_cast<double>(bins - 1)));
-        };
-        for (const Ref& ref : range)
+        for_each([&](const Ref& ref) {
             for (std::size_t axis = 0; axis < 3; ++axis) {
                 if (scale[axis] == 0.0) continue;
-                Bin& b = bin[axis * bins + bin_index(ref, axis)];
+                Bin& b = bin[axis * bins + choice.bin_index(ref, axis)];
                 b.box = b.box.merged(ref.box);
                 b.count += 1.0;
             }
+        });
         CutCost best;
-        std::size_t best_axis = 3;
-        std::uint32_t best_boundary = 0;
         std::vector<Aabb> right_sides(bins);
         std::vector<double> right_counts(bins);
         for (std::size_t axis = 0; axis < 3; ++axis) {
@@ -318,14 +540,10 @@ private:
                 count += b[boundary - 1].count;
                 if (count == 0 || right_counts[boundary] == 0) continue;
                 const CutCost cost = cut_cost(count, running, right_counts[boundary], right_sides[boundary]);
-                if (cost < best) best = cost, best_axis = axis, best_boundary = boundary;
+                if (cost < best) best = cost, choice.axis = axis, choice.boundary = boundary;
             }
         }
-        if (best_axis == 3) return 0;
-        // std::partition's result depends only on the range's contents and order, never on threads.
-        const auto middle = std::partition(range.begin(), range.end(),
-                                           [&](const Ref& ref) { return bin_index(ref, best_axis) < best_boundary; });
-        return static_cast<std::uint32_t>(middle - range.begin());
+        return choice;
     }
 
     /// Cuts are priced by the sides' world boxes whatever kinds are allowed: pricing OBBs and capsules in the
@@ -355,10 +573,23 @@ private:
         return static_cast<std::uint32_t>(range.size() / 2);
     }
 
+    /// Sorts by the centres along `axis`, ties by local index (a total order, so one result however sorted):
+    /// 16-byte keys are sorted and the refs moved once, which is cheaper than sorting the refs themselves.
     static void sort_along(std::span<Ref> range, int axis) {
-        std::sort(range.begin(), range.end(), [axis](const Ref& a, const Ref& b) {
-            return a.centre[axis] != b.centre[axis] ? a.centre[axis] < b.centre[axis] : a.local < b.local;
-        });
+        struct Key {
+            double at;
+            std::uint32_t local, position;
+        };
+        thread_local std::vector<Key> keys;
+        thread_local std::vector<Ref> sorted;
+        keys.resize(range.size());
+        for (std::size_t i = 0; i < range.size(); ++i)
+            keys[i] = {range[i].centre[axis], range[i].local, static_cast<std::uint32_t>(i)};
+        std::sort(keys.begin(), keys.end(),
+                  [](const Key& a, const Key& b) { return a.at != b.at ? a.at < b.at : a.local < b.local; });
+        sorted.resize(range.size());
+        for (std::size_t i = 0; i < range.size(); ++i) sorted[i] = range[keys[i].position];
+        std::copy(sorted.begin(), sorted.end(), range.begin());
     }
 
     // ---- Step 2: the collapse --------------------------------------------------------------------------
@@ -371,17 +602,25 @@ private:
     // volume priced is the node's box, the one volume known for every binary node without a fit; the kept
     // nodes are fitted afterwards (step 3), which only makes them smaller.
     CollapseCosts collapse_costs(std::uint32_t slot, const CollapseCosts& left, const CollapseCosts& right) {
-        const BinaryNode& node = nodes_[slot];
+        return combine(left, right, nodes_[slot].box, split_of(slot));
+    }
+
+    /// collapse_costs of a node with box `box` over subtrees with costs `left` and `right`; records the choices
+    /// in `split` unless it is null.
+    [[nodiscard]] CollapseCosts combine(const CollapseCosts& left, const CollapseCosts& right, const Aabb& box,
+                                        std::uint8_t* split) const {
         CollapseCosts best;
         best.fill(infinity);
-        std::uint8_t* split = split_of(slot);
         const std::uint32_t m = max_children_;
         for (std::uint32_t k = 2; k <= m; ++k)
             for (std::uint32_t i = 1; i < k; ++i) {
                 const double cost = left[i] + right[k - i];
-                if (cost < best[k]) best[k] = cost, split[k] = static_cast<std::uint8_t>(i);
+                if (cost < best[k]) {
+                    best[k] = cost;
+                    if (split != nullptr) split[k] = static_cast<std::uint8_t>(i);
+                }
             }
-        const double volume = box_weight_ * box_measure(node.box);
+        const double volume = box_weight_ * box_measure(box);
         double kept = infinity;
         std::uint8_t children = 2;
         for (std::uint32_t k = 2; k <= m; ++k) {
@@ -389,7 +628,7 @@ private:
             if (cost < kept) kept = cost, children = static_cast<std::uint8_t>(k);
         }
         best[1] = kept;
-        split[1] = children;
+        if (split != nullptr) split[1] = children;
         return best;
     }
 

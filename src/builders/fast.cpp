@@ -21,13 +21,15 @@ namespace hbvh {
 namespace {
 
 /// binned without its three slow steps for small inputs: the per-side fits of its cuts (estimate sweeps),
-/// fit_best on every kept node and split's tree beside its own. What is left is the box-priced cuts, the
-/// collapse and one cheap fit a node.
+/// fit_best on every kept node and split's tree beside its own. What is left is the box-priced cuts (the root's
+/// chosen by a look-ahead over `lookahead_candidates` cuts), the collapse and one cheap fit a node.
 /// Where the treelet sweep follows, no node gets more children than a treelet has units: a wider node's
 /// children could never be re-grouped (on the duplo brick, an 8-child node kept the tree at 1.11x auto's cost;
 /// at most 5 children, 1.05x; no other object of docs/fast.md changed).
-BinnedOptions cheap_binned(std::uint32_t max_children) {
+BinnedOptions cheap_binned(std::uint32_t max_children, std::uint32_t lookahead_candidates) {
     BinnedOptions options;
+    options.lookahead_depth = lookahead_candidates > 0 ? 1 : 0;
+    options.lookahead_candidates = lookahead_candidates;
     options.estimate_sweep_up_to = 0;
     options.exact_fit_all_up_to = 0;
     options.max_children = max_children;
@@ -81,7 +83,7 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     const bool sweep = options.treelet_units >= 3 && primitives.size() <= options.treelet_max_primitives;
     Result<Bvh> built =
         build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
-                                                                : BinnedOptions{}.max_children));
+                                                                : BinnedOptions{}.max_children, options.lookahead_candidates));
     if (!built || context.expired()) return built;
     // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is
     // most of the gap to auto (docs/fast.md). Treelets priced by the cheap fitter close much of it for a few

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -170,6 +171,113 @@ TEST(Binned, NeverCostlierThanSplitUpToItsLimit) {
     }
     EXPECT_GT(split_kept, 0);
     EXPECT_GT(own_kept, 0);
+}
+
+/// binned's own tree with box-priced cuts (no estimate sweeps, as in `fast`) and the root's look-ahead over
+/// `candidates` cuts (0: the greedy cut alone).
+BinnedOptions looking_ahead(std::uint32_t candidates, std::uint32_t max_children) {
+    BinnedOptions options = own_tree();
+    options.estimate_sweep_up_to = 0;
+    options.lookahead_depth = candidates > 0 ? 1 : 0;
+    options.lookahead_candidates = candidates;
+    options.max_children = max_children;
+    return options;
+}
+
+/// Box volume of the primitives `members` (input indices).
+double box_volume_of(std::span<const Primitive> primitives, std::span<const std::uint32_t> members) {
+    Aabb box = Aabb::empty();
+    for (const std::uint32_t i : members) box = box.merged(world_aabb(primitives[i].volume));
+    return box.volume();
+}
+
+/// The primitives `members` (input indices), in input order.
+std::vector<Primitive> subset(std::span<const Primitive> primitives, std::vector<std::uint32_t> members) {
+    std::sort(members.begin(), members.end());
+    std::vector<Primitive> out;
+    for (const std::uint32_t i : members) out.push_back(primitives[i]);
+    return out;
+}
+
+// With AABBs only and binary nodes (max_children 2) a tree's cost is the sum of twice each inner node's box volume,
+// so the tree of a root cut is 2 x the root's volume plus the trees of its sides, each of which binned builds
+// alone exactly as it plans it inside the whole (a range's cuts depend on its primitives only). The look-ahead must
+// return the cheapest such tree among its candidates: the greedy cut and the local minima of the sweep's price
+// along each axis, both recomputed here from the price's definition (2 log2 n x box volume per side), each side's
+// tree built by a separate call.
+TEST(Binned, LookAheadKeepsTheCheapestTreeAmongItsCandidateCuts) {
+    int improved = 0;
+    for (std::uint32_t seed = 1; seed <= 12; ++seed) {
+        const std::uint32_t count = 6 + 5 * seed;  // 11 .. 66: sweeps, binned cuts and (66) no look-ahead at all
+        const std::vector<Primitive> primitives = generated_scene(count, 300 + seed, seed % 3 == 0);
+        SCOPED_TRACE("seed " + std::to_string(seed) + ", " + std::to_string(count) + " primitives");
+        const Bvh greedy = binned(primitives, boxes_only(), looking_ahead(0, 2));
+        const Bvh ahead = binned(primitives, boxes_only(), looking_ahead(64, 2));
+        expect_tree_properties(primitives, ahead);
+        if (count > 64) {
+            expect_identical_trees(greedy, ahead);
+            continue;
+        }
+        auto side_cost = [&](const std::vector<std::uint32_t>& members) {
+            return members.size() == 1 ? 0.0 : cost(binned(subset(primitives, members), boxes_only(), looking_ahead(0, 2)));
+        };
+        std::vector<std::uint32_t> all(count);
+        for (std::uint32_t i = 0; i < count; ++i) all[i] = i;
+        const double root = 2.0 * box_volume_of(primitives, all);
+        std::vector<double> candidates{cost(greedy)};
+        for (int axis = 0; axis < 3; ++axis) {
+            std::vector<std::uint32_t> order = all;
+            std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) {
+                return world_aabb(primitives[a].volume).center()[axis] < world_aabb(primitives[b].volume).center()[axis];
+            });
+            std::vector<double> price(count, 0.0);
+            for (std::uint32_t left = 1; left < count; ++left) {
+                const std::span<const std::uint32_t> sorted(order);
+                price[left] = 2.0 * std::log2(left) * box_volume_of(primitives, sorted.first(left)) +
+                              2.0 * std::log2(count - left) * box_volume_of(primitives, sorted.subspan(left));
+            }
+            for (std::uint32_t left = 1; left < count; ++left) {
+                const bool minimum = (left == 1 || price[left] <= price[left - 1]) && (left + 1 == count || price[left] < price[left + 1]);
+                if (!minimum) continue;
+                const std::vector<std::uint32_t> low(order.begin(), order.begin() + left), high(order.begin() + left, order.end());
+                candidates.push_back(root + side_cost(low) + side_cost(high));
+            }
+        }
+        const double best = *std::min_element(candidates.begin(), candidates.end());
+        EXPECT_NEAR(cost(ahead), best, 1e-12 * best);
+        if (cost(ahead) < cost(greedy) * (1.0 - 1e-9)) ++improved;
+    }
+    EXPECT_GE(improved, 3);
+}
+
+// Wide nodes too (the collapse prices every kept node by its box, which is its volume here): the look-ahead's
+// choice is priced with the collapse, so its tree is never dearer than the greedy cut's, whatever the candidates.
+TEST(Binned, LookAheadIsNeverDearerThanTheGreedyCutUnderBoxes) {
+    int improved = 0;
+    for (std::uint32_t seed = 1; seed <= 20; ++seed)
+        for (const std::uint32_t candidates : {1u, 6u})
+            for (const std::uint32_t max_children : {4u, 8u}) {
+                const std::uint32_t count = 8 + (seed * 7) % 57;
+                const std::vector<Primitive> primitives = generated_scene(count, 500 + seed, seed % 2 == 0);
+                SCOPED_TRACE("seed " + std::to_string(seed) + ", candidates " + std::to_string(candidates) +
+                             ", max_children " + std::to_string(max_children));
+                const Bvh greedy = binned(primitives, boxes_only(), looking_ahead(0, max_children));
+                const Bvh ahead = binned(primitives, boxes_only(), looking_ahead(candidates, max_children));
+                expect_tree_properties(primitives, ahead);
+                EXPECT_LE(cost(ahead), cost(greedy) * (1.0 + 1e-12));
+                if (cost(ahead) < cost(greedy) * (1.0 - 1e-9)) ++improved;
+            }
+    EXPECT_GE(improved, 5);
+}
+
+// Equal centres and zero volumes, where every cut prices the same: the look-ahead still gives a valid tree.
+TEST(Binned, LookAheadOnCoincidentAndFlatInputs) {
+    const std::vector<Primitive> coincident(40, Primitive{Sphere{Vec3(1, 2, 3), 0.5}, ""});
+    expect_tree_properties(coincident, binned(coincident, VolumePolicy::all(), looking_ahead(6, 8)));
+    std::vector<Primitive> flat;
+    for (int i = 0; i < 50; ++i) flat.push_back({Aabb{Vec3(i % 7, i / 7, 0.0), Vec3(i % 7 + 0.5, i / 7 + 0.5, 0.0)}, ""});
+    expect_tree_properties(flat, binned(flat, boxes_only(), looking_ahead(6, 8)));
+    expect_tree_properties(flat, binned(flat, VolumePolicy::all(), looking_ahead(6, 5)));
 }
 
 TEST(Binned, CoincidentAndFlatScenes) {

@@ -22,6 +22,13 @@ struct BinnedOptions {
     /// In inputs of at most this many primitives, ranges of at most 64 are swept with each side priced by
     /// the pricing fitter around it (as split prices its small nodes) instead of by its box.
     std::uint32_t estimate_sweep_up_to = 2000;
+    /// A look-ahead for the top cuts of small objects: ranges of at most 64 primitives shallower than
+    /// `lookahead_depth` (0: none) are cut where the two sides, each planned greedily below, give the least
+    /// collapsed box cost, among the greedy cut and the `lookahead_candidates` cheapest local minima of the
+    /// sweep's price along each axis. Only where no estimate sweep is made (inputs above `estimate_sweep_up_to`). `fast` looks ahead
+    /// at the root: the greedy first cut was most of its gap to `auto` on three models (docs/fast.md).
+    std::uint32_t lookahead_depth = 0;
+    std::uint32_t lookahead_candidates = 6;
     /// The most children a node of the result may have (2..16). The collapse keeps a binary node only where
     /// that lowers Eq. 2; this bounds how many it may merge into one.
     std::uint32_t max_children = 8;

@@ -30,10 +30,15 @@ struct FastOptions {
     /// Nodes over more primitives than this are not refitted (fit_best is O(n log n) with a large constant:
     /// seconds at 10^6 primitives), so the preset stays fast at any size.
     std::uint32_t exact_fit_max_primitives = 256;
+    /// The root's cut is chosen by a look-ahead over this many candidate cuts (0: the greedy cut): each candidate's
+    /// two sides are planned greedily and priced by their collapsed boxes (BinnedOptions::lookahead_candidates).
+    /// Inputs of at most 64 primitives; a few microseconds per candidate (docs/fast.md).
+    std::uint32_t lookahead_candidates = 6;
 };
 
 /// A hierarchy in about a millisecond for a few dozen primitives (O(n log n) beyond the refits):
-/// 1. binned's binary tree (cuts between sorted centres priced by the sides' boxes), its Eq. 2-optimal
+/// 1. binned's binary tree (cuts between sorted centres priced by the sides' boxes, the root's chosen by a
+///    look-ahead over `lookahead_candidates` cuts, each side planned greedily and priced by its boxes), its Eq. 2-optimal
 ///    collapse into nodes of up to 8 children, and its cheap fit of each kept node (exact AABB, the box in the
 ///    principal and DiTO frames, the capsule on the main axis, the sphere around the box centre);
 /// 2. up to `treelet_max_primitives` primitives, one sweep of treelet refinement with `treelet_units` units whose
