@@ -46,10 +46,12 @@ struct FastOptions {
 ///    replaced only where that makes the tree cheaper;
 /// 3. the `exact_fits` inner nodes with the largest children x weighted volume (among those over at most
 ///    `exact_fit_max_primitives` primitives) refitted with fit_best over their primitives, each kept only where
-///    it is cheaper (so the tree is never costlier than step 1's).
+///    it is cheaper (so the tree is never costlier than step 1's). The root's refit, which does not depend on
+///    the tree's shape, runs on another core from the start, beside steps 1 and 2.
 /// Its trees cost more than `auto`'s (docs/fast.md has the table); use it where build time matters more.
 /// Deterministic for any thread count (the refits are independent and run in parallel).
-/// Deadline: binned's checks, then between treelets and before each refit (once passed, the rest is skipped).
+/// Deadline: binned's checks, then between treelets and before each refit (once passed, the rest is skipped; the
+/// root's refit, started first, is used).
 [[nodiscard]] Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context,
                                      const FastOptions& options = {});
 
