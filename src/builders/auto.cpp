@@ -11,6 +11,7 @@
 #include "guarded_build.hpp"
 #include "report_text.hpp"
 #include "treelet_fit_cache.hpp"
+#include "../tree/collapse.hpp"
 #include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/assert.hpp"
@@ -111,6 +112,18 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             costs += (costs.empty() ? "" : ", ") + outcomes[m].costs;
     }
     Bvh best = std::move(**outcomes[winner].tree);
+    // Treelets re-group a few units at a time and never dissolve a node into a parent outside the treelet; the
+    // exact collapse does, and only lowers the cost (on 300 copies of one sphere, the refined trees were 1.14x the
+    // flat one). O(nodes x depth) time and memory, so up to the portfolio's range; beyond, binned has collapsed
+    // its own tree.
+    std::size_t dissolved = 0;
+    double before_collapse = 0.0;
+    if (primitives.size() <= auto_portfolio_max_primitives) {
+        before_collapse = cost(best, context.policy);
+        const std::size_t nodes = best.nodes.size();
+        best = detail::collapse_optimally(best, context.policy);
+        dissolved = nodes - best.nodes.size();
+    }
     const TreeletReport best_treelets = outcomes[winner].treelets;
     if (context.report != nullptr) {
         *context.report = std::move(outcomes[winner].report);
@@ -126,6 +139,10 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             context.report->budget_hit = true;
         }
         if (refine > 0) note_treelets(*context.report, best_treelets);
+        if (dissolved > 0)
+            context.report->notes.push_back("auto: the exact collapse dissolved " + std::to_string(dissolved) + " nodes, cost " +
+                                            detail::format_cost(before_collapse) + " -> " +
+                                            detail::format_cost(cost(best, context.policy)));
     }
     return Result<Bvh>(std::move(best));
 }

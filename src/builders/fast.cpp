@@ -14,6 +14,7 @@
 
 #include "guarded_build.hpp"
 #include "treelet_fit_cache.hpp"
+#include "../tree/collapse.hpp"
 #include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/fit/fit.hpp"
@@ -37,6 +38,9 @@ BinnedOptions cheap_binned(std::uint32_t max_children, std::uint32_t lookahead_c
     options.guarantee_split_up_to = 0;
     return options;
 }
+
+/// Up to this many primitives the finished tree goes through the exact collapse (its table is O(nodes x depth)).
+constexpr std::size_t collapse_max_primitives = 2000;
 
 /// Primitives below each node (nodes are breadth-first, so children come after their parent).
 std::vector<std::uint32_t> primitive_counts(const Bvh& bvh) {
@@ -161,6 +165,15 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
         context.report->notes.push_back("fast: fit_best on the " + std::to_string(heaviest.size()) +
                                         " heaviest inner nodes, cheaper on " + std::to_string(kept));
     if (context.expired()) context.note_deadline("fast: refits after the deadline skipped");
+    // As auto does: dissolve the nodes whose removal lowers Eq. 2 (exact, O(nodes x depth)), where the tree is
+    // small enough for its table.
+    if (options.collapse && primitives.size() <= collapse_max_primitives) {
+        const std::size_t nodes = bvh.nodes.size();
+        bvh = detail::collapse_optimally(bvh, context.policy);
+        if (context.report != nullptr && bvh.nodes.size() < nodes)
+            context.report->notes.push_back("fast: the exact collapse dissolved " + std::to_string(nodes - bvh.nodes.size()) +
+                                            " nodes");
+    }
     context.report_progress(1.0);
     return detail::check_build_output(std::move(built), "fast");
 }

@@ -34,6 +34,9 @@ struct FastOptions {
     /// two sides are planned greedily and priced by their collapsed boxes (BinnedOptions::lookahead_candidates).
     /// Inputs of at most 64 primitives; a few microseconds per candidate (docs/fast.md).
     std::uint32_t lookahead_candidates = 6;
+    /// Last, up to 2 000 primitives, the nodes whose removal lowers Eq. 2 are dissolved into their parents (the
+    /// exact collapse over every subset of inner nodes, O(nodes x depth)): 0-3 % cheaper trees (docs/fast.md).
+    bool collapse = true;
 };
 
 /// A hierarchy in about a millisecond for a few dozen primitives (O(n log n) beyond the refits):
@@ -47,7 +50,8 @@ struct FastOptions {
 /// 3. the `exact_fits` inner nodes with the largest children x weighted volume (among those over at most
 ///    `exact_fit_max_primitives` primitives) refitted with fit_best over their primitives, each kept only where
 ///    it is cheaper (so the tree is never costlier than step 1's). The root's refit, which does not depend on
-///    the tree's shape, runs on another core from the start, beside steps 1 and 2.
+///    the tree's shape, runs on another core from the start, beside steps 1 and 2;
+/// 4. with `collapse`, the exact collapse: the nodes whose removal lowers Eq. 2 dissolved into their parents.
 /// Its trees cost more than `auto`'s (docs/fast.md has the table); use it where build time matters more.
 /// Deterministic for any thread count (the refits are independent and run in parallel).
 /// Deadline: binned's checks, then between treelets and before each refit (once passed, the rest is skipped; the
