@@ -110,6 +110,9 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     // fifth of the preset's time on 13-54 primitives, docs/fast.md). Used only if the root is among the
     // heaviest nodes (it is an inner node from 2 primitives on, and within the size cap here).
     std::optional<BoundingVolume> root_refit;
+    // Sets of primitives refitted in the background during the sweep (below), with their fits. Declared before
+    // the task group, so that its tasks are waited for before these go away.
+    std::vector<std::pair<std::vector<std::uint32_t>, std::optional<BoundingVolume>>> early;
     tbb::task_group background;
     const WaitOnExit wait_for_background{background};
     if (options.exact_fits > 0 && primitives.size() >= 2 && primitives.size() <= options.exact_fit_max_primitives)
@@ -122,6 +125,18 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
         build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
                                                                 : BinnedOptions{}.max_children, options.lookahead_candidates));
     if (!built || context.expired()) return built;
+    // The heaviest nodes below the root of the cheap tree are refitted in the background too, during the sweep: a
+    // refit depends on its set of primitives only, and the sweep re-arranges treelets of a few units, so such a
+    // set is often still a heavy node afterwards. On the peers' 17 objects of up to 64 primitives the preset took
+    // up to a quarter less time (the cannon 1 % more); where the sweep re-forms that node (generated-30-7) the
+    // background fit takes a core from the sweep for nothing, about 10 % more (docs/fast.md).
+    if (sweep && options.exact_fits > 1) {
+        for (const std::uint32_t node :
+             heaviest_inner_nodes(*built, context.policy, options.exact_fits, options.exact_fit_max_primitives))
+            if (node != 0) early.emplace_back(covered_primitives(*built, node), std::nullopt);
+        for (auto& [set, fit] : early)
+            background.run([&, &set = set, &fit = fit] { fit = best_fit_of(primitives, set, context.policy); });
+    }
     // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is
     // most of the gap to auto (docs/fast.md). Treelets priced by the cheap fitter close much of it for a few
     // hundred microseconds, where fit_best's pricing (auto's) would cost a hundred times more.
@@ -144,12 +159,25 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     // Each refit reads the tree's shape and primitives only, so they run in parallel and the result does not
     // depend on the thread count (without a deadline; with one, a refit that would start after it is skipped).
     std::vector<std::optional<BoundingVolume>> refits(heaviest.size());
-    tbb::parallel_for(std::size_t{0}, heaviest.size(), [&](std::size_t k) {
-        if (heaviest[k] != 0 && !context.expired()) refits[k] = best_fit_below(bvh, heaviest[k], context.policy);
+    std::vector<std::vector<std::uint32_t>> sets(heaviest.size());
+    std::vector<std::size_t> fresh;  // the heaviest nodes whose set no background refit covers
+    for (std::size_t k = 0; k < heaviest.size(); ++k) {
+        if (heaviest[k] == 0) continue;
+        sets[k] = covered_primitives(bvh, heaviest[k]);
+        if (std::none_of(early.begin(), early.end(), [&](const auto& e) { return e.first == sets[k]; })) fresh.push_back(k);
+    }
+    tbb::parallel_for(std::size_t{0}, fresh.size(), [&](std::size_t i) {
+        if (!context.expired()) refits[fresh[i]] = best_fit_of(bvh.primitives, sets[fresh[i]], context.policy);
     });
     background.wait();
-    for (std::size_t k = 0; k < heaviest.size(); ++k)
-        if (heaviest[k] == 0) refits[k] = std::move(root_refit);
+    for (std::size_t k = 0; k < heaviest.size(); ++k) {
+        if (heaviest[k] == 0) {
+            refits[k] = std::move(root_refit);
+            continue;
+        }
+        for (auto& [set, fit] : early)
+            if (set == sets[k] && fit) refits[k] = fit;
+    }
     std::size_t kept = 0;
     for (std::size_t k = 0; k < heaviest.size(); ++k) {
         if (!refits[k]) continue;
