@@ -4,6 +4,7 @@
 #include "hbvh/builders/fast.hpp"
 
 #include <algorithm>
+#include <deque>
 #include <optional>
 #include <string>
 #include <utility>
@@ -80,106 +81,69 @@ BoundingVolume best_fit_of(std::span<const Primitive> primitives, std::span<cons
     return fit_best(input.spheres, policy, input.hint_axes);
 }
 
-/// fit_best over the primitives below `node`.
-BoundingVolume best_fit_below(const Bvh& bvh, std::uint32_t node, const VolumePolicy& policy) {
-    return best_fit_of(bvh.primitives, covered_primitives(bvh, node), policy);
-}
-
-/// Waits for a task group however the scope is left (a task_group must not be destroyed with tasks running).
-/// The normal path waits explicitly, so that a task's exception reaches the caller; here, on the way out of an
-/// early return or an exception, it is dropped.
-struct WaitOnExit {
-    tbb::task_group& tasks;
-    ~WaitOnExit() {
+/// fit_best refits started early on the second core: a refit depends on its set of primitives only, so one made
+/// before the tree is final serves any node of the final tree over the same set (the trees are those of fitting
+/// last). Sets are added before any is read; the destructor waits for the tasks.
+class EarlyRefits {
+public:
+    EarlyRefits(std::span<const Primitive> primitives, const VolumePolicy& policy) : primitives_(primitives), policy_(policy) {}
+    EarlyRefits(const EarlyRefits&) = delete;
+    EarlyRefits& operator=(const EarlyRefits&) = delete;
+    ~EarlyRefits() {
         try {
-            tasks.wait();
-        } catch (...) {
+            tasks_.wait();
+        } catch (...) {  // only on the way out of an early return or an exception; take() reports a task's failure
         }
     }
+
+    /// Starts fit_best over `set` (input indices, ascending).
+    void start(std::vector<std::uint32_t> set) {
+        Refit& refit = refits_.emplace_back(Refit{std::move(set), std::nullopt});
+        tasks_.run([this, &refit] { refit.fit = best_fit_of(primitives_, refit.set, policy_); });
+    }
+    [[nodiscard]] bool started(std::span<const std::uint32_t> set) const {
+        return std::any_of(refits_.begin(), refits_.end(), [&](const Refit& r) { return std::ranges::equal(r.set, set); });
+    }
+    /// The fit of `set`, once every started refit is done; nothing if none was started for it.
+    [[nodiscard]] std::optional<BoundingVolume> take(std::span<const std::uint32_t> set) {
+        tasks_.wait();
+        for (Refit& refit : refits_)
+            if (std::ranges::equal(refit.set, set)) return refit.fit;
+        return std::nullopt;
+    }
+
+private:
+    struct Refit {
+        std::vector<std::uint32_t> set;
+        std::optional<BoundingVolume> fit;
+    };
+    std::span<const Primitive> primitives_;
+    const VolumePolicy& policy_;
+    std::deque<Refit> refits_;  // a deque: adding one moves none, so the running tasks' references stay valid
+    tbb::task_group tasks_;
 };
 
-}  // namespace
-
-Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context, const FastOptions& options) {
-    // binned reports its progress as the first half, the refits the second.
-    BuildContext first_step = context;
-    if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };
-    const bool sweep = options.treelet_units >= 3 && primitives.size() <= options.treelet_max_primitives;
-    // The root covers every primitive whatever the tree's shape, and it nearly always weighs most, so its refit
-    // starts now on another core, beside the cheap build and the sweep, instead of after them (a tenth to a
-    // fifth of the preset's time on 13-54 primitives, docs/fast.md). Used only if the root is among the
-    // heaviest nodes (it is an inner node from 2 primitives on, and within the size cap here).
-    std::optional<BoundingVolume> root_refit;
-    // Sets of primitives refitted in the background during the sweep (below), with their fits. Declared before
-    // the task group, so that its tasks are waited for before these go away.
-    std::vector<std::pair<std::vector<std::uint32_t>, std::optional<BoundingVolume>>> early;
-    tbb::task_group background;
-    const WaitOnExit wait_for_background{background};
-    if (options.exact_fits > 0 && primitives.size() >= 2 && primitives.size() <= options.exact_fit_max_primitives)
-        background.run([&] {
-            std::vector<std::uint32_t> all(primitives.size());
-            for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
-            root_refit = best_fit_of(primitives, all, context.policy);
-        });
-    Result<Bvh> built =
-        build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
-                                                                : BinnedOptions{}.max_children, options.lookahead_candidates));
-    if (!built || context.expired()) return built;
-    // The heaviest nodes below the root of the cheap tree are refitted in the background too, during the sweep: a
-    // refit depends on its set of primitives only, and the sweep re-arranges treelets of a few units, so such a
-    // set is often still a heavy node afterwards. On the peers' 17 objects of up to 64 primitives the preset took
-    // up to a quarter less time (the cannon 1 % more); where the sweep re-forms that node (generated-30-7) the
-    // background fit takes a core from the sweep for nothing, about 10 % more (docs/fast.md).
-    if (sweep && options.exact_fits > 1) {
-        for (const std::uint32_t node :
-             heaviest_inner_nodes(*built, context.policy, options.exact_fits, options.exact_fit_max_primitives))
-            if (node != 0) early.emplace_back(covered_primitives(*built, node), std::nullopt);
-        for (auto& [set, fit] : early)
-            background.run([&, &set = set, &fit = fit] { fit = best_fit_of(primitives, set, context.policy); });
-    }
-    // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is
-    // most of the gap to auto (docs/fast.md). Treelets priced by the cheap fitter close much of it for a few
-    // hundred microseconds, where fit_best's pricing (auto's) would cost a hundred times more.
-    if (sweep) {
-        detail::TreeletFitCache quick_fits(built->primitives.size(), detail::TreeletFitter::quick);
-        TreeletOptions treelets;
-        treelets.max_units = options.treelet_units;
-        treelets.max_passes = 1;  // a second changed no cost by more than 0.01 % with 4 units (docs/fast.md)
-        TreeletReport report;
-        *built = detail::refine_treelets_cached(*built, context.policy, treelets_within(context, treelets), quick_fits,
-                                                &report);
-        if (context.report != nullptr)
-            context.report->notes.push_back("fast: " + std::to_string(report.treelets) + " treelets priced by quick fits, " +
-                                            std::to_string(report.replaced) + " re-arranged");
-    }
-    if (context.expired() || options.exact_fits == 0) return detail::check_build_output(std::move(built), "fast");
-    Bvh& bvh = *built;
-    const std::vector<std::uint32_t> heaviest =
-        heaviest_inner_nodes(bvh, context.policy, options.exact_fits, options.exact_fit_max_primitives);
-    // Each refit reads the tree's shape and primitives only, so they run in parallel and the result does not
-    // depend on the thread count (without a deadline; with one, a refit that would start after it is skipped).
-    std::vector<std::optional<BoundingVolume>> refits(heaviest.size());
+/// Refits the `exact_fits` heaviest inner nodes (over at most `max_primitives` primitives) with fit_best, taking
+/// the early refits where their sets agree and fitting the rest in parallel now; each new volume is kept only
+/// where it is cheaper. Returns (nodes refitted, nodes made cheaper).
+std::pair<std::size_t, std::size_t> refit_heaviest(Bvh& bvh, const BuildContext& context, std::uint32_t exact_fits,
+                                                   std::uint32_t max_primitives, EarlyRefits& early) {
+    const std::vector<std::uint32_t> heaviest = heaviest_inner_nodes(bvh, context.policy, exact_fits, max_primitives);
     std::vector<std::vector<std::uint32_t>> sets(heaviest.size());
-    std::vector<std::size_t> fresh;  // the heaviest nodes whose set no background refit covers
+    std::vector<std::size_t> now;  // the nodes whose set no early refit covers
     for (std::size_t k = 0; k < heaviest.size(); ++k) {
-        if (heaviest[k] == 0) continue;
         sets[k] = covered_primitives(bvh, heaviest[k]);
-        if (std::none_of(early.begin(), early.end(), [&](const auto& e) { return e.first == sets[k]; })) fresh.push_back(k);
+        if (!early.started(sets[k])) now.push_back(k);
     }
-    tbb::parallel_for(std::size_t{0}, fresh.size(), [&](std::size_t i) {
-        if (!context.expired()) refits[fresh[i]] = best_fit_of(bvh.primitives, sets[fresh[i]], context.policy);
+    // Each refit reads its set only, so they run in parallel and the result does not depend on the thread count
+    // (without a deadline; with one, a refit that would start after it is skipped).
+    std::vector<std::optional<BoundingVolume>> refits(heaviest.size());
+    tbb::parallel_for(std::size_t{0}, now.size(), [&](std::size_t i) {
+        if (!context.expired()) refits[now[i]] = best_fit_of(bvh.primitives, sets[now[i]], context.policy);
     });
-    background.wait();
-    for (std::size_t k = 0; k < heaviest.size(); ++k) {
-        if (heaviest[k] == 0) {
-            refits[k] = std::move(root_refit);
-            continue;
-        }
-        for (auto& [set, fit] : early)
-            if (set == sets[k] && fit) refits[k] = fit;
-    }
     std::size_t kept = 0;
     for (std::size_t k = 0; k < heaviest.size(); ++k) {
+        if (!refits[k]) refits[k] = early.take(sets[k]);
         if (!refits[k]) continue;
         Node& node = bvh.nodes[heaviest[k]];
         // fit_best tries more frames than the cheap fit but not all of them (DiTO's frames are binned's, the
@@ -189,10 +153,61 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
             ++kept;
         }
     }
-    if (context.report != nullptr)
-        context.report->notes.push_back("fast: fit_best on the " + std::to_string(heaviest.size()) +
-                                        " heaviest inner nodes, cheaper on " + std::to_string(kept));
-    if (context.expired()) context.note_deadline("fast: refits after the deadline skipped");
+    return {heaviest.size(), kept};
+}
+
+}  // namespace
+
+Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context, const FastOptions& options) {
+    // binned reports its progress as the first half, the refits the second.
+    BuildContext first_step = context;
+    if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };
+    const bool sweep = options.treelet_units >= 3 && primitives.size() <= options.treelet_max_primitives;
+    const bool refit = options.exact_fits > 0 && primitives.size() >= 2;
+    // The root covers every primitive whatever the tree's shape, and it nearly always weighs most, so its refit
+    // starts now, beside the cheap build and the sweep, instead of after them (a tenth to a fifth of the preset's
+    // time on 13-54 primitives, docs/fast.md). It is an inner node from 2 primitives on.
+    EarlyRefits early(primitives, context.policy);
+    if (refit && primitives.size() <= options.exact_fit_max_primitives) {
+        std::vector<std::uint32_t> all(primitives.size());
+        for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+        early.start(std::move(all));
+    }
+    Result<Bvh> built =
+        build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
+                                                                : BinnedOptions{}.max_children, options.lookahead_candidates));
+    if (!built || context.expired()) return built;
+    Bvh& bvh = *built;
+    // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is
+    // most of the gap to auto (docs/fast.md). Treelets priced by the cheap fitter close much of it for a few
+    // hundred microseconds, where fit_best's pricing (auto's) would cost a hundred times more.
+    if (sweep) {
+        // The heaviest nodes below the root of the cheap tree are refitted during the sweep: it re-arranges
+        // treelets of a few units, so such a set is often still a heavy node afterwards. On the peers' 17 objects
+        // of up to 64 primitives the preset took up to a quarter less time (the cannon 1 % more); where the sweep
+        // re-forms that node (generated-30-7) the early fit takes a core from the sweep for nothing, about 10 %
+        // more (docs/fast.md).
+        if (refit && options.exact_fits > 1)
+            for (const std::uint32_t node : heaviest_inner_nodes(bvh, context.policy, options.exact_fits, options.exact_fit_max_primitives))
+                if (node != 0) early.start(covered_primitives(bvh, node));
+        detail::TreeletFitCache quick_fits(bvh.primitives.size(), detail::TreeletFitter::quick);
+        TreeletOptions treelets;
+        treelets.max_units = options.treelet_units;
+        treelets.max_passes = 1;  // a second changed no cost by more than 0.01 % with 4 units (docs/fast.md)
+        TreeletReport report;
+        bvh = detail::refine_treelets_cached(bvh, context.policy, treelets_within(context, treelets), quick_fits, &report);
+        if (context.report != nullptr)
+            context.report->notes.push_back("fast: " + std::to_string(report.treelets) + " treelets priced by quick fits, " +
+                                            std::to_string(report.replaced) + " re-arranged");
+    }
+    if (refit && !context.expired()) {
+        const auto [refitted, cheaper] =
+            refit_heaviest(bvh, context, options.exact_fits, options.exact_fit_max_primitives, early);
+        if (context.report != nullptr)
+            context.report->notes.push_back("fast: fit_best on the " + std::to_string(refitted) +
+                                            " heaviest inner nodes, cheaper on " + std::to_string(cheaper));
+        if (context.expired()) context.note_deadline("fast: refits after the deadline skipped");
+    }
     // As auto does: dissolve the nodes whose removal lowers Eq. 2 (exact, O(nodes x depth)), where the tree is
     // small enough for its table.
     if (options.collapse && primitives.size() <= collapse_max_primitives) {
