@@ -2,7 +2,7 @@
 // The speed preset: build_fast's time per build and its tree's Eq. 2 cost relative to auto's, without the quick
 // treelet sweep and with 4-6 units per treelet (FastOptions::treelet_units), and for 0, 2, 4 and 8 refitted
 // nodes (FastOptions::exact_fits), with and without the root's look-ahead (FastOptions::lookahead_candidates), on the
-// bundled models and generated objects of 30 primitives. The defaults (5 units, 2 refits, 8 candidates) are chosen
+// bundled models and generated objects of 30 primitives. The defaults (5 units, 2 refits, 6 candidates) are chosen
 // from this table and the peers' objects (docs/fast.md).
 #include <benchmark/benchmark.h>
 

@@ -25,8 +25,9 @@ struct BinnedOptions {
     /// A look-ahead for the top cuts of small objects: ranges of at most 64 primitives shallower than
     /// `lookahead_depth` (0: none) are cut where the two sides, each planned greedily below, give the least
     /// collapsed box cost, among the greedy cut and the `lookahead_candidates` cheapest local minima of the
-    /// sweep's price along each axis. Only where no estimate sweep is made (inputs above `estimate_sweep_up_to`). `fast` looks ahead
-    /// at the root: the greedy first cut was most of its gap to `auto` on three models (docs/fast.md).
+    /// sweep's price along each axis. Only where no estimate sweep is made (inputs above
+    /// `estimate_sweep_up_to`). `fast` looks ahead at the root: the greedy first cut was most of its gap to
+    /// `auto` on four models (docs/fast.md).
     std::uint32_t lookahead_depth = 0;
     std::uint32_t lookahead_candidates = 6;
     /// The most children a node of the result may have (2..16). The collapse keeps a binary node only where

@@ -35,7 +35,7 @@ struct FastOptions {
     /// Inputs of at most 64 primitives; a few microseconds per candidate (docs/fast.md).
     std::uint32_t lookahead_candidates = 6;
     /// Last, up to 2 000 primitives, the nodes whose removal lowers Eq. 2 are dissolved into their parents (the
-    /// exact collapse over every subset of inner nodes, O(nodes x depth)): 0-3 % cheaper trees (docs/fast.md).
+    /// exact collapse over every subset of inner nodes, O(nodes x depth)): up to 3 % cheaper trees (docs/fast.md).
     bool collapse = true;
 };
 
@@ -49,13 +49,14 @@ struct FastOptions {
 ///    replaced only where that makes the tree cheaper;
 /// 3. the `exact_fits` inner nodes with the largest children x weighted volume (among those over at most
 ///    `exact_fit_max_primitives` primitives) refitted with fit_best over their primitives, each kept only where
-///    it is cheaper (so the tree is never costlier than step 1's). The root's refit, which does not depend on
-///    the tree's shape, runs on another core from the start, beside steps 1 and 2;
+///    it is cheaper (so the tree is never costlier than step 1's). A refit depends on its set of primitives only,
+///    so the root's starts on another core before step 1, and those of the cheap tree's heaviest nodes below the
+///    root during step 2, each used where a final heaviest node has its set;
 /// 4. with `collapse`, the exact collapse: the nodes whose removal lowers Eq. 2 dissolved into their parents.
 /// Its trees cost more than `auto`'s (docs/fast.md has the table); use it where build time matters more.
 /// Deterministic for any thread count (the refits are independent and run in parallel).
 /// Deadline: binned's checks, then between treelets and before each refit (once passed, the rest is skipped; the
-/// root's refit, started first, is used).
+/// refits started early are used).
 [[nodiscard]] Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context,
                                      const FastOptions& options = {});
 
