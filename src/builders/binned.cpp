@@ -240,6 +240,7 @@ private:
             side_.resize(size);
             scratch_.resize(size);
             right_sides_.resize(size);
+            for (const Ref& ref : range) whole_ = whole_.merged(ref.box);
         }
 
         /// Every cut of the whole range priced as sweep_cut prices it: (cost, axis, left count), in sweep order.
@@ -262,24 +263,15 @@ private:
             std::array<std::vector<std::uint32_t>, 3> lists = sorted_;
             std::array<std::span<std::uint32_t>, 3> spans{std::span(lists[0]), std::span(lists[1]), std::span(lists[2])};
             const auto [left_costs, right_costs] = cut_and_plan(spans, axis, left, depth + 1);
-            Aabb whole = Aabb::empty();
-            for (const Ref& ref : range_) whole = whole.merged(ref.box);
-            return builder_.combine(left_costs, right_costs, whole, nullptr)[1];
+            return builder_.combine(left_costs, right_costs, whole_, nullptr)[1];
         }
 
     private:
         /// Calls visit(left count, cost) for every cut of `list` (positions sorted along one axis).
         template <class Visit>
         void sweep(std::span<const std::uint32_t> list, Visit&& visit) {
-            const std::size_t count = list.size();
-            Aabb running = Aabb::empty();
-            for (std::size_t i = count; i-- > 0;) right_sides_[i] = running = running.merged(range_[list[i]].box);
-            running = Aabb::empty();
-            for (std::size_t left = 1; left < count; ++left) {
-                running = running.merged(range_[list[left - 1]].box);
-                visit(static_cast<std::uint32_t>(left),
-                      builder_.cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides_[left]));
-            }
+            builder_.price_cuts(list.size(), [&](std::size_t i) -> const Aabb& { return range_[list[i]].box; },
+                                right_sides_, visit);
         }
 
         /// The collapse costs of the sub-range whose positions are in `lists` (one list per axis, each sorted).
@@ -357,6 +349,7 @@ private:
         std::vector<std::uint8_t> side_;
         std::vector<std::uint32_t> scratch_;
         std::vector<Aabb> right_sides_;
+        Aabb whole_ = Aabb::empty();  ///< The range's box, the root's of every trial.
     };
 
     /// Whether plan() looks ahead at a range: near the top of small inputs, where one greedy cut decides the
@@ -423,17 +416,28 @@ private:
         std::size_t best_cut = count / 2;
         for (int axis = 0; axis < 3; ++axis) {
             sort_along(range, axis);
-            Aabb running = Aabb::empty();
-            for (std::size_t i = count; i-- > 0;) right_sides[i] = running = running.merged(range[i].box);
-            running = Aabb::empty();
-            for (std::size_t left = 1; left < count; ++left) {
-                running = running.merged(range[left - 1].box);
-                const CutCost cost = cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides[left]);
-                if (cost < best) best = cost, best_axis = axis, best_cut = left;  // ties: the earlier axis and cut
-            }
+            price_cuts(count, [&](std::size_t i) -> const Aabb& { return range[i].box; }, right_sides,
+                       [&](std::uint32_t left, const CutCost& cost) {
+                           if (cost < best) best = cost, best_axis = axis, best_cut = left;  // ties: the earlier axis and cut
+                       });
         }
         if (best_axis != 2) sort_along(range, best_axis);
         return static_cast<std::uint32_t>(best_cut);
+    }
+
+    /// Calls visit(left count, cost) for every cut of `count` primitives in order, the i-th's box being box_at(i):
+    /// each side's box grows by one primitive per cut (`right_sides` is scratch of at least `count`). sweep_cut's
+    /// pricing, shared with the look-ahead's trials so that both price every cut alike.
+    template <class BoxAt, class Visit>
+    void price_cuts(std::size_t count, BoxAt&& box_at, std::vector<Aabb>& right_sides, Visit&& visit) const {
+        Aabb running = Aabb::empty();
+        for (std::size_t i = count; i-- > 0;) right_sides[i] = running = running.merged(box_at(i));
+        running = Aabb::empty();
+        for (std::size_t left = 1; left < count; ++left) {
+            running = running.merged(box_at(left - 1));
+            visit(static_cast<std::uint32_t>(left),
+                  cut_cost(static_cast<double>(left), running, static_cast<double>(count - left), right_sides[left]));
+        }
     }
 
     [[nodiscard]] double estimate_weight(double count) const { return count_weighted_estimates_ ? count : side_weight(count); }

@@ -18,21 +18,19 @@ Bvh collapse_optimally(const Bvh& bvh, const VolumePolicy& policy) {
     if (n < 2 || bvh.nodes[0].is_leaf()) return bvh;
     // Breadth-first order: a parent comes before its children, so depths are filled in one pass and a reverse
     // pass visits children before parents.
-    std::vector<std::uint32_t> depth(n, 0);
+    // The parents too: a node's ancestor at depth j is found by climbing.
+    std::vector<std::uint32_t> depth(n, 0), parent(n, 0);
     std::vector<double> weight(n, 0.0);
     std::vector<std::uint64_t> offset(n + 1, 0);  // node v's table is table[offset[v], offset[v] + depth[v])
     for (std::uint32_t v = 0; v < n; ++v) {
         const Node& node = bvh.nodes[v];
         if (!node.is_leaf()) weight[v] = policy.weighted_volume(node.volume);
-        for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) depth[c] = depth[v] + 1;
+        for (std::uint32_t c = node.first_child; c < node.first_child + node.child_count; ++c) {
+            depth[c] = depth[v] + 1;
+            parent[c] = v;
+        }
         offset[v + 1] = offset[v] + depth[v];
     }
-    // Ancestors' weights along the path, per node: its ancestor at depth j is found by climbing, so the parents
-    // are recorded too.
-    std::vector<std::uint32_t> parent(n, 0);
-    for (std::uint32_t v = 0; v < n; ++v)
-        for (std::uint32_t c = bvh.nodes[v].first_child; c < bvh.nodes[v].first_child + bvh.nodes[v].child_count; ++c)
-            parent[c] = v;
     std::vector<double> table(offset[n], 0.0);
     std::vector<std::uint8_t> kept(offset[n], 1);  // the choice for v under the ancestor at depth j
     std::vector<double> ancestor_weight;
