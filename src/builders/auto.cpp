@@ -114,11 +114,10 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     Bvh best = std::move(**outcomes[winner].tree);
     // Treelets re-group a few units at a time and never dissolve a node into a parent outside the treelet; the
     // exact collapse does, and only lowers the cost (on 300 copies of one sphere, the refined trees were 1.14x the
-    // flat one). O(nodes x depth) time and memory, so up to the portfolio's range; beyond, binned has collapsed
-    // its own tree.
+    // flat one).
     std::size_t dissolved = 0;
     double before_collapse = 0.0;
-    if (primitives.size() <= auto_portfolio_max_primitives) {
+    if (primitives.size() <= detail::collapse_max_primitives) {
         before_collapse = cost(best, context.policy);
         const std::size_t nodes = best.nodes.size();
         best = detail::collapse_optimally(best, context.policy);

@@ -40,9 +40,6 @@ BinnedOptions cheap_binned(std::uint32_t max_children, std::uint32_t lookahead_c
     return options;
 }
 
-/// Up to this many primitives the finished tree goes through the exact collapse (its table is O(nodes x depth)).
-constexpr std::size_t collapse_max_primitives = 2000;
-
 /// Primitives below each node (nodes are breadth-first, so children come after their parent).
 std::vector<std::uint32_t> primitive_counts(const Bvh& bvh) {
     std::vector<std::uint32_t> counts(bvh.nodes.size(), 0);
@@ -210,7 +207,7 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     }
     // As auto does: dissolve the nodes whose removal lowers Eq. 2 (exact, O(nodes x depth)), where the tree is
     // small enough for its table.
-    if (options.collapse && primitives.size() <= collapse_max_primitives) {
+    if (options.collapse && primitives.size() <= detail::collapse_max_primitives) {
         const std::size_t nodes = bvh.nodes.size();
         bvh = detail::collapse_optimally(bvh, context.policy);
         if (context.report != nullptr && bvh.nodes.size() < nodes)
