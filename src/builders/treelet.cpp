@@ -15,6 +15,8 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <limits>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -22,6 +24,7 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/builders/optimal.hpp"
 #include "optimal_plan.hpp"
+#include "treelet_bounds.hpp"
 #include "treelet_fit_cache.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/fit/fit_fast.hpp"
@@ -46,7 +49,9 @@ public:
     Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
         : primitives_(bvh.primitives), policy_(policy),
           max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits),
-          fitter_(cache.fitter()) {
+          fitter_(cache.fitter()),
+          bound_fits_(options.bound_fits && fitter_ == detail::TreeletFitter::best &&
+                      (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule))) {
         items_.reserve(bvh.nodes.size());
         for (const Node& node : bvh.nodes) {
             Item item{node.volume, {}, node.primitive};
@@ -102,6 +107,27 @@ private:
         return fit_fast(input.spheres, hints, policy_);
     }
 
+    /// Fits the sets of `masks` (keys[mask], sorted primitive indices) in parallel, each depending on its set
+    /// only, so the result does not depend on the thread count; they go to the shared cache and to `fitted`.
+    void fit_masks(std::span<const std::uint32_t> masks, std::span<const std::vector<std::uint32_t>> keys,
+                   std::vector<const Fitted*>& fitted) {
+        std::vector<Fitted> fresh(masks.size());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                BoundingVolume bv = fit_set(keys[masks[j]]);
+                fresh[j].weighted = policy_.weighted_volume(bv);
+                fresh[j].volume = std::move(bv);
+            }
+        });
+        fits_ += masks.size();
+        for (std::size_t j = 0; j < masks.size(); ++j) {
+            // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical
+            // (same set, same primitives, same policy), so either copy will do.
+            const auto it = cache_.emplace(keys[masks[j]], std::move(fresh[j])).first;
+            fitted[masks[j]] = &it->second;  // the map never moves its elements
+        }
+    }
+
     [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {
         std::vector<std::uint32_t> out;
         std::vector<std::uint32_t> stack{id};
@@ -121,6 +147,7 @@ private:
     std::vector<Item> items_;
     detail::TreeletFitCache::Map& cache_;
     detail::TreeletFitter fitter_;
+    bool bound_fits_;
     std::uint64_t fits_ = 0;
 };
 
@@ -164,61 +191,83 @@ bool Refiner::refine_at(std::uint32_t root) {
         current += static_cast<double>(items_[*it].children.size()) * policy_.weighted_volume(items_[*it].volume);
     }
 
-    // Stage 3: fit_best (or the quick fitter) over the primitives of every union of two or more units.
-    // Covered sets recur across treelets, passes and (through a shared cache) refinements of other trees over
-    // the same primitives, so fits are cached by set; the missing ones are fitted in parallel, each depending
-    // on its set only, so the result does not depend on the thread count.
+    // Stage 3: the covered set of every union of two or more units, and its fit where the cache has it.
     std::vector<std::vector<std::uint32_t>> unit_primitives(units);
     for (std::uint32_t i = 0; i < units; ++i) unit_primitives[i] = covered(frontier[i]);
     const std::uint32_t subsets = 1u << units;
     std::vector<const Fitted*> fitted(subsets, nullptr);
-    std::vector<std::pair<std::uint32_t, std::vector<std::uint32_t>>> missing;
+    std::vector<std::vector<std::uint32_t>> keys(subsets);
+    std::vector<std::uint32_t> missing;
     for (std::uint32_t mask = 1; mask < subsets; ++mask) {
         if (std::popcount(mask) < 2) continue;
-        std::vector<std::uint32_t> key;
-        for (std::uint32_t i = 0; i < units; ++i)
-            if (mask >> i & 1u) key.insert(key.end(), unit_primitives[i].begin(), unit_primitives[i].end());
-        std::sort(key.begin(), key.end());
+        // The union of the mask without its lowest unit (built before, a smaller mask) and that unit, merged.
+        const std::uint32_t rest = mask & (mask - 1u);
+        const std::vector<std::uint32_t>& lowest = unit_primitives[std::countr_zero(mask)];
+        const std::vector<std::uint32_t>& others =
+            std::popcount(rest) > 1 ? keys[rest] : unit_primitives[std::countr_zero(rest)];
+        std::vector<std::uint32_t>& key = keys[mask];
+        key.resize(lowest.size() + others.size());
+        std::merge(lowest.begin(), lowest.end(), others.begin(), others.end(), key.begin());
         if (auto found = cache_.find(key); found != cache_.end())
             fitted[mask] = &found->second;
         else
-            missing.emplace_back(mask, std::move(key));
-    }
-    std::vector<Fitted> fresh(missing.size());
-    const auto fit_range = [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t j = range.begin(); j != range.end(); ++j) {
-            BoundingVolume bv = fit_set(missing[j].second);
-            fresh[j].weighted = policy_.weighted_volume(bv);
-            fresh[j].volume = std::move(bv);
-        }
-    };
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, missing.size(), 4), fit_range);
-    fits_ += missing.size();
-    for (std::size_t j = 0; j < missing.size(); ++j) {
-        // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical
-        // (same set, same primitives, same policy), so either copy will do.
-        const auto it = cache_.emplace(std::move(missing[j].second), std::move(fresh[j])).first;
-        fitted[missing[j].first] = &it->second;  // the map never moves its elements
+            missing.push_back(mask);
     }
 
     // Stage 4: the subset volumes. Where the current tree already has a node over a set and its BV is
     // allowed and no larger than the fit, keep it: then the current arrangement is one of the DP's
     // candidates at its current cost, so the optimum can only be cheaper.
-    std::vector<double> volume(subsets, 0.0);
-    std::vector<std::uint32_t> keep(subsets, 0);  // item id + 1 whose BV to keep, 0 = use the fit
-    for (std::uint32_t mask = 1; mask < subsets; ++mask)
-        if (fitted[mask] != nullptr) volume[mask] = fitted[mask]->weighted;
+    std::vector<double> kept_volume(subsets, std::numeric_limits<double>::infinity());
+    std::vector<std::uint32_t> kept_id(subsets, 0);  // item id + 1 of the current node over the set, 0 = none
     for (std::uint32_t id : expanded) {
         const std::uint32_t mask = mask_of.at(id);
         const BoundingVolume& bv = items_[id].volume;
-        const double weighted = policy_.weighted_volume(bv);
-        if (policy_.is_allowed(type_of(bv)) && weighted <= volume[mask]) {
-            volume[mask] = weighted;
-            keep[mask] = id + 1;
-        }
+        if (!policy_.is_allowed(type_of(bv))) continue;
+        kept_volume[mask] = policy_.weighted_volume(bv);
+        kept_id[mask] = id + 1;
     }
-    const OptimalPlan plan = solve_optimal_hierarchy(units, volume);
-    if (!(plan.cost < current * (1.0 - 1e-12))) return false;
+    std::vector<double> volume(subsets, 0.0);
+    std::vector<std::uint32_t> keep(subsets, 0);  // item id + 1 whose BV to keep, 0 = use the fit
+    const auto settle = [&](std::uint32_t mask) {
+        volume[mask] = fitted[mask]->weighted;
+        if (kept_volume[mask] <= volume[mask]) {
+            volume[mask] = kept_volume[mask];
+            keep[mask] = kept_id[mask];
+        }
+    };
+    for (std::uint32_t mask = 1; mask < subsets; ++mask)
+        if (fitted[mask] != nullptr) settle(mask);
+
+    // The missing fits, on demand: each set stands in by a lower bound of its weighted volume (TreeletBounds)
+    // until the DP's optimum uses it; then the optimum's missing sets are fitted and the DP solved again. An
+    // optimum that uses fitted sets only is the optimum over the fits (every other tree costs at least its
+    // bounds), and one no cheaper than the current tree proves that no fit would make it cheaper. So the answer
+    // is the one of fitting every set (up to a choice between trees of equal cost), with fewer fits. Where a fit
+    // costs about what a bound does (the quick fitter; fit_best without boxes and capsules), every set is fitted.
+    if (bound_fits_ && !missing.empty()) {
+        double margin = std::numeric_limits<double>::infinity();
+        for (std::uint32_t i = 0; i < units; ++i)
+            margin = std::min(margin, detail::least_radius(primitives_, unit_primitives[i]));
+        std::vector<std::vector<Vec3>> unit_points(units);
+        for (std::uint32_t i = 0; i < units; ++i)
+            unit_points[i] = detail::points_inside(primitives_, unit_primitives[i], margin);
+        detail::TreeletBounds bounds(std::move(unit_points), margin, policy_);
+        for (std::uint32_t mask : missing) volume[mask] = std::min(bounds.bound(mask), kept_volume[mask]);
+    } else {
+        fit_masks(missing, keys, fitted);
+        for (std::uint32_t mask : missing) settle(mask);
+    }
+    OptimalPlan plan;
+    for (;;) {
+        plan = solve_optimal_hierarchy(units, volume);
+        if (!(plan.cost < current * (1.0 - 1e-12))) return false;
+        std::vector<std::uint32_t> needed;
+        for (const OptimalGroup& group : plan.groups)
+            if (fitted[group.covered] == nullptr) needed.push_back(group.covered);
+        if (needed.empty()) break;
+        fit_masks(needed, keys, fitted);
+        for (std::uint32_t mask : needed) settle(mask);
+    }
 
     // Stage 5: rebuild the treelet, children before parents. The root keeps its id so that its parent
     // and the caller's postorder stay valid; the replaced inner nodes are left unreferenced.

@@ -19,6 +19,10 @@ struct TreeletOptions {
     std::uint32_t max_passes = 3;
     /// Wall-clock limit in seconds (0 = none); checked between treelets, the tree so far is returned.
     double time_limit_seconds = 0.0;
+    /// Fit a set only once the DP's optimum, with lower bounds (hull volumes) standing in for the sets not
+    /// fitted yet, uses it: the same optimum (docs/treelets.md, "Fits on demand") with 2-10x fewer fits. false:
+    /// fit every set of every treelet first, as before 2026-12-06 (for comparisons and tests).
+    bool bound_fits = true;
 };
 
 /// What refine_treelets did.
