@@ -24,7 +24,6 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/builders/optimal.hpp"
 #include "optimal_plan.hpp"
-#include "treelet_bounds.hpp"
 #include "treelet_fit_cache.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/fit/fit_fast.hpp"
@@ -49,7 +48,7 @@ public:
     Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
         : primitives_(bvh.primitives), policy_(policy),
           max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits),
-          fitter_(cache.fitter()),
+          bounds_(cache.bounds), bound_scale_(detail::bound_scale(policy)), fitter_(cache.fitter()),
           bound_fits_(options.bound_fits && fitter_ == detail::TreeletFitter::best &&
                       (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule))) {
         items_.reserve(bvh.nodes.size());
@@ -128,6 +127,33 @@ private:
         }
     }
 
+    /// The bound of the units in `mask` (sets keys[mask], or unit_primitives for one unit): from the shared cache,
+    /// else built from the bounds of the mask without its lowest unit and of that unit, and cached.
+    const detail::SetBound& bound_of(std::uint32_t mask, std::span<const std::vector<std::uint32_t>> keys,
+                                     std::span<const std::vector<std::uint32_t>> unit_primitives,
+                                     std::vector<const detail::SetBound*>& known) {
+        if (known[mask] != nullptr) return *known[mask];
+        const auto set_of = [&](std::uint32_t m) -> const std::vector<std::uint32_t>& {
+            return std::popcount(m) == 1 ? unit_primitives[std::countr_zero(m)] : keys[m];
+        };
+        auto found = bounds_.find(set_of(mask));
+        if (found == bounds_.end()) {
+            detail::SetBound made;
+            if (std::popcount(mask) == 1) {
+                made = detail::bound_set(primitives_, set_of(mask), bound_scale_);
+            } else {
+                const std::uint32_t rest = mask & (mask - 1u);
+                const std::uint32_t lowest = mask & ~rest;
+                const detail::SetBound& a = bound_of(rest, keys, unit_primitives, known);
+                const detail::SetBound& b = bound_of(lowest, keys, unit_primitives, known);
+                made = detail::bound_union(primitives_, a, set_of(rest), b, set_of(lowest), bound_scale_);
+            }
+            found = bounds_.emplace(set_of(mask), std::move(made)).first;
+        }
+        known[mask] = &found->second;  // the map never moves its elements
+        return found->second;
+    }
+
     [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {
         std::vector<std::uint32_t> out;
         std::vector<std::uint32_t> stack{id};
@@ -146,6 +172,8 @@ private:
     std::uint32_t max_units_;
     std::vector<Item> items_;
     detail::TreeletFitCache::Map& cache_;
+    detail::TreeletFitCache::BoundMap& bounds_;
+    double bound_scale_;
     detail::TreeletFitter fitter_;
     bool bound_fits_;
     std::uint64_t fits_ = 0;
@@ -238,21 +266,16 @@ bool Refiner::refine_at(std::uint32_t root) {
     for (std::uint32_t mask = 1; mask < subsets; ++mask)
         if (fitted[mask] != nullptr) settle(mask);
 
-    // The missing fits, on demand: each set stands in by a lower bound of its weighted volume (TreeletBounds)
+    // The missing fits, on demand: each set stands in by a lower bound of its weighted volume (treelet_bounds.hpp)
     // until the DP's optimum uses it; then the optimum's missing sets are fitted and the DP solved again. An
     // optimum that uses fitted sets only is the optimum over the fits (every other tree costs at least its
     // bounds), and one no cheaper than the current tree proves that no fit would make it cheaper. So the answer
     // is the one of fitting every set (up to a choice between trees of equal cost), with fewer fits. Where a fit
     // costs about what a bound does (the quick fitter; fit_best without boxes and capsules), every set is fitted.
     if (bound_fits_ && !missing.empty()) {
-        double margin = std::numeric_limits<double>::infinity();
-        for (std::uint32_t i = 0; i < units; ++i)
-            margin = std::min(margin, detail::least_radius(primitives_, unit_primitives[i]));
-        std::vector<std::vector<Vec3>> unit_points(units);
-        for (std::uint32_t i = 0; i < units; ++i)
-            unit_points[i] = detail::points_inside(primitives_, unit_primitives[i], margin);
-        detail::TreeletBounds bounds(std::move(unit_points), margin, policy_);
-        for (std::uint32_t mask : missing) volume[mask] = std::min(bounds.bound(mask), kept_volume[mask]);
+        std::vector<const detail::SetBound*> known(subsets, nullptr);
+        for (std::uint32_t mask : missing)
+            volume[mask] = std::min(bound_of(mask, keys, unit_primitives, known).bound, kept_volume[mask]);
     } else {
         fit_masks(missing, keys, fitted);
         for (std::uint32_t mask : missing) settle(mask);

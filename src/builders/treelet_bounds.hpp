@@ -23,30 +23,31 @@ namespace hbvh::detail {
 [[nodiscard]] std::vector<Vec3> points_inside(std::span<const Primitive> primitives, std::span<const std::uint32_t> set,
                                               double margin);
 
-/// Lower bounds of the weighted measure of every allowed volume around the union of some units (bit i of a
-/// mask: unit i). Each such volume is convex and holds H, the hull of the units' points_inside grown by the
-/// margin, so its volume is at least H's (Steiner's formula: V + S m + (1/2) sum of edge length x exterior
-/// angle m^2 + 4/3 pi m^3 for a polytope of volume V and area S grown by m), and its self-Minkowski measure
-/// at least 8 times that (Brunn-Minkowski: vol(K - K) >= 8 vol(K), and K - K holds H - H); times the least
-/// weight among the allowed kinds. A mask's hull is built from the hull vertices of the mask without its
-/// lowest unit and of that unit, so each hull sees few points.
-class TreeletBounds {
-public:
-    TreeletBounds(std::vector<std::vector<Vec3>> unit_points, double margin, const VolumePolicy& policy);
-    /// The bound for the units in `mask` (any non-empty mask); the ball of the margin where their points span
-    /// no solid.
-    [[nodiscard]] double bound(std::uint32_t mask);
+/// What a bound is multiplied by: the least weight among the allowed kinds, times 8 under the Minkowski
+/// measure (Brunn-Minkowski: vol(K - K) >= 8 vol(K), and K - K holds H - H for H inside K), less a millionth
+/// for the rounding of the hull's and the fits' volumes.
+[[nodiscard]] double bound_scale(const VolumePolicy& policy);
 
-private:
-    /// Replaces the mask's points by their hull's vertices and records its bound. Where no hull is made (no
-    /// solid, or more points than the small-set hull takes) the points stay and the bound is the margin's ball.
-    void hull_of(std::uint32_t mask);
-
-    std::vector<std::vector<Vec3>> points_;
-    std::vector<double> bound_;  ///< -1 until computed
-    std::vector<Vec3> unit_normals_;  ///< hull_of's scratch
-    double margin_ = 0.0;
-    double scale_ = 1.0;
+/// A lower bound of the weighted measure of every allowed volume around a set of primitives. Each such volume
+/// is convex and holds H, the hull of the set's points_inside grown by the set's least radius (the margin), so
+/// its volume is at least H's: by Steiner's formula V + S m + (1/2) sum of edge length x exterior angle m^2 +
+/// 4/3 pi m^3 for a polytope of volume V and area S grown by m (each angle taken as the chord between its
+/// faces' unit normals, which is below it).
+struct SetBound {
+    double bound = 0.0;
+    double margin = 0.0;
+    /// The hull's vertices (all the points where no hull was made: no solid, or more than the small-set hull
+    /// takes; the bound is then the margin's ball): a union's hull is built from its parts'.
+    std::vector<Vec3> points;
 };
+
+/// The bound of `set` from its own points.
+[[nodiscard]] SetBound bound_set(std::span<const Primitive> primitives, std::span<const std::uint32_t> set, double scale);
+
+/// The bound of the union of two disjoint sets from theirs: each part contributes its hull's vertices where its
+/// margin is the union's, else its points recomputed for the union's margin. So each hull sees few points.
+[[nodiscard]] SetBound bound_union(std::span<const Primitive> primitives, const SetBound& a,
+                                   std::span<const std::uint32_t> set_a, const SetBound& b,
+                                   std::span<const std::uint32_t> set_b, double scale);
 
 }  // namespace hbvh::detail

@@ -10,6 +10,7 @@
 
 #include "hbvh/builders/treelet.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
+#include "treelet_bounds.hpp"
 
 namespace hbvh::detail {
 
@@ -51,6 +52,11 @@ public:
     [[nodiscard]] TreeletFitter fitter() const { return fitter_; }
     using Map = tbb::concurrent_unordered_map<std::vector<std::uint32_t>, TreeletFit, CoveredSetHash>;
     Map fits;
+    /// The lower bounds of the fits on demand (treelet_bounds.hpp), by covered set likewise. A set's bound may
+    /// differ in its last bits by the union it was built from; a bound only decides which sets are fitted, and
+    /// the tree is the optimum over the fits whichever they are (docs/treelets.md, "Fits on demand").
+    using BoundMap = tbb::concurrent_unordered_map<std::vector<std::uint32_t>, SetBound, CoveredSetHash>;
+    BoundMap bounds;
 
 private:
     std::size_t primitive_count_;

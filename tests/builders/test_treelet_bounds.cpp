@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -33,26 +34,36 @@ std::vector<VolumePolicy> policies() {
             VolumePolicy::only(BvType::capsule), VolumePolicy::only(BvType::aabb)};
 }
 
-/// The bounds of every mask of `units` (disjoint sets of primitive indices) against fit_best over the mask's
-/// primitives. Returns the ratios bound / fit.
+/// The bounds of every mask of `units` (disjoint sets of primitive indices), each from the mask's own points and
+/// built up unit by unit as the refiner does, against fit_best over the mask's primitives. Returns the ratios
+/// bound / fit.
 std::vector<double> check_masks(std::span<const Primitive> primitives, const std::vector<std::vector<std::uint32_t>>& units,
                                 const VolumePolicy& policy, const std::string& what) {
-    double margin = std::numeric_limits<double>::infinity();
-    for (const auto& unit : units) margin = std::min(margin, detail::least_radius(primitives, unit));
-    std::vector<std::vector<Vec3>> points;
-    for (const auto& unit : units) points.push_back(detail::points_inside(primitives, unit, margin));
-    detail::TreeletBounds bounds(points, margin, policy);
+    const double scale = detail::bound_scale(policy);
+    const std::size_t subsets = std::size_t{1} << units.size();
+    std::vector<std::vector<std::uint32_t>> sets(subsets);
+    std::vector<detail::SetBound> built(subsets);
     std::vector<double> ratios;
-    for (std::uint32_t mask = 1; mask < (1u << units.size()); ++mask) {
+    for (std::uint32_t mask = 1; mask < subsets; ++mask) {
+        const std::uint32_t rest = mask & (mask - 1u);
+        const std::uint32_t lowest = mask & ~rest;
+        if (rest == 0) {
+            sets[mask] = units[static_cast<std::size_t>(std::countr_zero(mask))];
+            built[mask] = detail::bound_set(primitives, sets[mask], scale);
+        } else {
+            sets[mask] = sets[rest];
+            sets[mask].insert(sets[mask].end(), sets[lowest].begin(), sets[lowest].end());
+            std::sort(sets[mask].begin(), sets[mask].end());
+            built[mask] = detail::bound_union(primitives, built[rest], sets[rest], built[lowest], sets[lowest], scale);
+        }
         FitInput input;
-        for (std::size_t i = 0; i < units.size(); ++i)
-            if (mask >> i & 1u)
-                for (std::uint32_t p : units[i]) input.add(primitives[p].volume);
+        for (std::uint32_t p : sets[mask]) input.add(primitives[p].volume);
         const double fitted = policy.weighted_volume(fit_best(input.spheres, policy, input.hint_axes));
-        const double bound = bounds.bound(mask);
-        EXPECT_LE(bound, fitted) << what << ", mask " << mask;
-        EXPECT_GE(bound, 0.0) << what << ", mask " << mask;
-        ratios.push_back(bound / fitted);
+        const double own = detail::bound_set(primitives, sets[mask], scale).bound;
+        EXPECT_LE(built[mask].bound, fitted) << what << ", mask " << mask;
+        EXPECT_LE(own, fitted) << what << ", mask " << mask;
+        EXPECT_GE(built[mask].bound, 0.0) << what << ", mask " << mask;
+        ratios.push_back(built[mask].bound / fitted);
     }
     return ratios;
 }
@@ -96,20 +107,23 @@ TEST(TreeletBounds, MatchesSteinersFormulaForBallsAtACubesCorners) {
         std::vector<Primitive> primitives;
         for (int corner = 0; corner < 8; ++corner)
             primitives.push_back(Primitive{Sphere{Vec3(corner & 1, corner >> 1 & 1, corner >> 2 & 1), r}, ""});
-        std::vector<std::vector<std::uint32_t>> units{{0, 1, 2, 3}, {4, 5, 6, 7}};
-        const double margin = std::min(detail::least_radius(primitives, units[0]), detail::least_radius(primitives, units[1]));
-        EXPECT_EQ(margin, r);
-        detail::TreeletBounds bounds({detail::points_inside(primitives, units[0], margin),
-                                      detail::points_inside(primitives, units[1], margin)},
-                                     margin, VolumePolicy::all());
+        const std::vector<std::uint32_t> low{0, 1, 2, 3};
+        const std::vector<std::uint32_t> high{4, 5, 6, 7};
+        const std::vector<std::uint32_t> all{0, 1, 2, 3, 4, 5, 6, 7};
+        const double scale = detail::bound_scale(VolumePolicy::all());
+        const detail::SetBound low_bound = detail::bound_set(primitives, low, scale);
+        const detail::SetBound high_bound = detail::bound_set(primitives, high, scale);
+        EXPECT_EQ(low_bound.margin, r);
+        const double both = detail::bound_union(primitives, low_bound, low, high_bound, high, scale).bound;
         const double pi = std::numbers::pi;
         const double exact = 1.0 + 6.0 * r + 3.0 * pi * r * r + 4.0 / 3.0 * pi * r * r * r;
         const double with_chords = 1.0 + 6.0 * r + 3.0 * pi * r * r * (2.0 * std::sin(pi / 4.0) / (pi / 2.0)) +
                                    4.0 / 3.0 * pi * r * r * r;
-        EXPECT_NEAR(bounds.bound(3u), with_chords, 1e-5 * exact) << "r " << r;
-        EXPECT_LT(bounds.bound(3u), exact) << "r " << r;
+        EXPECT_NEAR(both, with_chords, 1e-5 * exact) << "r " << r;
+        EXPECT_LT(both, exact) << "r " << r;
+        EXPECT_NEAR(detail::bound_set(primitives, all, scale).bound, both, 1e-9 * exact) << "r " << r;
         // Each half is a flat square of balls: no solid hull of centres, so the bound is one ball.
-        EXPECT_NEAR(bounds.bound(1u), 4.0 / 3.0 * pi * r * r * r, 1e-5 * exact) << "r " << r;
+        EXPECT_NEAR(low_bound.bound, 4.0 / 3.0 * pi * r * r * r, 1e-5 * exact) << "r " << r;
     }
 }
 
