@@ -16,7 +16,6 @@
 #include <bit>
 #include <chrono>
 #include <limits>
-#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
@@ -111,13 +110,14 @@ private:
     void fit_masks(std::span<const std::uint32_t> masks, std::span<const std::vector<std::uint32_t>> keys,
                    std::vector<const Fitted*>& fitted) {
         std::vector<Fitted> fresh(masks.size());
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 4), [&](const tbb::blocked_range<std::size_t>& range) {
+        const auto fit_range = [&](const tbb::blocked_range<std::size_t>& range) {
             for (std::size_t j = range.begin(); j != range.end(); ++j) {
                 BoundingVolume bv = fit_set(keys[masks[j]]);
                 fresh[j].weighted = policy_.weighted_volume(bv);
                 fresh[j].volume = std::move(bv);
             }
-        });
+        };
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 4), fit_range);
         fits_ += masks.size();
         for (std::size_t j = 0; j < masks.size(); ++j) {
             // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical

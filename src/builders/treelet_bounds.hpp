@@ -42,7 +42,8 @@ struct SetBound {
 };
 
 /// The bound of `set` from its own points.
-[[nodiscard]] SetBound bound_set(std::span<const Primitive> primitives, std::span<const std::uint32_t> set, double scale);
+[[nodiscard]] SetBound bound_set(std::span<const Primitive> primitives, std::span<const std::uint32_t> set,
+                                 double scale);
 
 /// The bound of the union of two disjoint sets from theirs: each part contributes its hull's vertices where its
 /// margin is the union's, else its points recomputed for the union's margin. So each hull sees few points.

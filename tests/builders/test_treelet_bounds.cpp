@@ -30,15 +30,16 @@ std::vector<VolumePolicy> policies() {
     weighted.weight = {1.0, 1.3, 0.45, 1.8};
     VolumePolicy minkowski = VolumePolicy::all();
     minkowski.measure = NodeMeasure::minkowski;
-    return {VolumePolicy::all(), weighted, minkowski, VolumePolicy::only(BvType::obb), VolumePolicy::only(BvType::sphere),
-            VolumePolicy::only(BvType::capsule), VolumePolicy::only(BvType::aabb)};
+    return {VolumePolicy::all(), weighted, minkowski, VolumePolicy::only(BvType::obb),
+            VolumePolicy::only(BvType::sphere), VolumePolicy::only(BvType::capsule), VolumePolicy::only(BvType::aabb)};
 }
 
 /// The bounds of every mask of `units` (disjoint sets of primitive indices), each from the mask's own points and
 /// built up unit by unit as the refiner does, against fit_best over the mask's primitives. Returns the ratios
 /// bound / fit.
-std::vector<double> check_masks(std::span<const Primitive> primitives, const std::vector<std::vector<std::uint32_t>>& units,
-                                const VolumePolicy& policy, const std::string& what) {
+std::vector<double> check_masks(std::span<const Primitive> primitives,
+                                const std::vector<std::vector<std::uint32_t>>& units, const VolumePolicy& policy,
+                                const std::string& what) {
     const double scale = detail::bound_scale(policy);
     const std::size_t subsets = std::size_t{1} << units.size();
     std::vector<std::vector<std::uint32_t>> sets(subsets);
