@@ -273,9 +273,26 @@ bool Refiner::refine_at(std::uint32_t root) {
     // is the one of fitting every set (up to a choice between trees of equal cost), with fewer fits. Where a fit
     // costs about what a bound does (the quick fitter; fit_best without boxes and capsules), every set is fitted.
     if (bound_fits_ && !missing.empty()) {
+        // A mask's bound is built from its lowest unit's and the rest's, so they are made a level (unit count) at a
+        // time, each level's in parallel: the cache and `known` take concurrent writes to distinct masks.
         std::vector<const detail::SetBound*> known(subsets, nullptr);
+        std::vector<std::vector<std::uint32_t>> by_level(units + 1);
+        std::vector<std::uint8_t> wanted(subsets, 0);
         for (std::uint32_t mask : missing)
-            volume[mask] = std::min(bound_of(mask, keys, unit_primitives, known).bound, kept_volume[mask]);
+            for (std::uint32_t m = mask; m != 0 && !wanted[m]; m &= m - 1u) {
+                wanted[m] = 1;
+                by_level[static_cast<std::size_t>(std::popcount(m))].push_back(m);
+                wanted[m & ~(m - 1u)] = 1;  // the lowest unit
+            }
+        for (std::uint32_t i = 0; i < units; ++i)
+            if (wanted[1u << i]) (void)bound_of(1u << i, keys, unit_primitives, known);
+        for (std::size_t level = 2; level <= units; ++level)
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, by_level[level].size(), 2),
+                              [&](const tbb::blocked_range<std::size_t>& range) {
+                                  for (std::size_t j = range.begin(); j != range.end(); ++j)
+                                      (void)bound_of(by_level[level][j], keys, unit_primitives, known);
+                              });
+        for (std::uint32_t mask : missing) volume[mask] = std::min(known[mask]->bound, kept_volume[mask]);
     } else {
         fit_masks(missing, keys, fitted);
         for (std::uint32_t mask : missing) settle(mask);
