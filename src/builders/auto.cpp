@@ -60,6 +60,15 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     // treelets cover many of the same sets: one cache fits each set once for all of them.
     detail::TreeletFitCache fits(primitives.size());
     std::vector<MemberOutcome> outcomes(members.size());
+    const auto refine_member = [&](MemberOutcome& outcome) {
+        **outcome.tree = detail::refine_treelets_cached(**outcome.tree, context.policy,
+                                                        treelets_within(context, options.treelets), fits, &outcome.treelets);
+        outcome.cost = outcome.treelets.cost_after;
+        outcome.costs += " -> " + detail::format_cost(outcome.cost);
+    };
+    // Where every member is refined, each refines its tree as soon as it is built, without waiting for the
+    // others' builds (a refinement depends on its tree only, so the trees are the same).
+    const bool refine_each = refined_count >= members.size();
     tbb::parallel_for(std::size_t{0}, members.size(), [&](std::size_t m) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
@@ -74,6 +83,7 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             outcome.costs = std::string(to_string(members[m])) + " " + detail::format_cost(outcome.cost);
         }
         outcome.tree = std::move(built);
+        if (refine_each && *outcome.tree) refine_member(outcome);
     });
     // The first error in list order ends the build; else the `refined_count` cheapest trees (list order on ties)
     // are refined.
@@ -87,13 +97,8 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     std::stable_sort(built.begin(), built.end(),
                      [&](std::size_t a, std::size_t b) { return outcomes[a].cost < outcomes[b].cost; });
     const std::size_t refine = std::min(refined_count, built.size());
-    tbb::parallel_for(std::size_t{0}, refine, [&](std::size_t r) {
-        MemberOutcome& outcome = outcomes[built[r]];
-        **outcome.tree = detail::refine_treelets_cached(**outcome.tree, context.policy,
-                                                        treelets_within(context, options.treelets), fits, &outcome.treelets);
-        outcome.cost = outcome.treelets.cost_after;
-        outcome.costs += " -> " + detail::format_cost(outcome.cost);
-    });
+    if (!refine_each)
+        tbb::parallel_for(std::size_t{0}, refine, [&](std::size_t r) { refine_member(outcomes[built[r]]); });
     // The callback is called from the calling thread only (BuildContext::progress), so once the members are done.
     context.report_progress(static_cast<double>(members.size()) / static_cast<double>(members.size() + 1));
 
