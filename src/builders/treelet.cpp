@@ -127,12 +127,12 @@ private:
         }
     }
 
-    /// The bound of the units in `mask` (sets keys[mask], or unit_primitives for one unit): from the shared cache,
-    /// else built from the bounds of the mask without its lowest unit and of that unit, and cached.
-    const detail::SetBound& bound_of(std::uint32_t mask, std::span<const std::vector<std::uint32_t>> keys,
-                                     std::span<const std::vector<std::uint32_t>> unit_primitives,
-                                     std::vector<const detail::SetBound*>& known) {
-        if (known[mask] != nullptr) return *known[mask];
+    /// Sets known[mask] to the bound of the units in `mask` (sets keys[mask], or unit_primitives for one unit):
+    /// from the shared cache, else built from the bounds of the mask without its lowest unit and of that unit
+    /// (which the caller has made first: refine_at goes a unit count at a time), and cached.
+    void make_bound(std::uint32_t mask, std::span<const std::vector<std::uint32_t>> keys,
+                    std::span<const std::vector<std::uint32_t>> unit_primitives,
+                    std::vector<const detail::SetBound*>& known) {
         const auto set_of = [&](std::uint32_t m) -> const std::vector<std::uint32_t>& {
             return std::popcount(m) == 1 ? unit_primitives[std::countr_zero(m)] : keys[m];
         };
@@ -144,14 +144,13 @@ private:
             } else {
                 const std::uint32_t rest = mask & (mask - 1u);
                 const std::uint32_t lowest = mask & ~rest;
-                const detail::SetBound& a = bound_of(rest, keys, unit_primitives, known);
-                const detail::SetBound& b = bound_of(lowest, keys, unit_primitives, known);
-                made = detail::bound_union(primitives_, a, set_of(rest), b, set_of(lowest), bound_scale_);
+                HBVH_ASSERT(known[rest] != nullptr && known[lowest] != nullptr);
+                made = detail::bound_union(primitives_, *known[rest], set_of(rest), *known[lowest], set_of(lowest),
+                                           bound_scale_);
             }
             found = bounds_.emplace(set_of(mask), std::move(made)).first;
         }
         known[mask] = &found->second;  // the map never moves its elements
-        return found->second;
     }
 
     [[nodiscard]] std::vector<std::uint32_t> covered(std::uint32_t id) const {
@@ -285,12 +284,12 @@ bool Refiner::refine_at(std::uint32_t root) {
                 wanted[m & ~(m - 1u)] = 1;  // the lowest unit
             }
         for (std::uint32_t i = 0; i < units; ++i)
-            if (wanted[1u << i]) (void)bound_of(1u << i, keys, unit_primitives, known);
+            if (wanted[1u << i]) make_bound(1u << i, keys, unit_primitives, known);
         for (std::size_t level = 2; level <= units; ++level)
             tbb::parallel_for(tbb::blocked_range<std::size_t>(0, by_level[level].size(), 2),
                               [&](const tbb::blocked_range<std::size_t>& range) {
                                   for (std::size_t j = range.begin(); j != range.end(); ++j)
-                                      (void)bound_of(by_level[level][j], keys, unit_primitives, known);
+                                      make_bound(by_level[level][j], keys, unit_primitives, known);
                               });
         for (std::uint32_t mask : missing) volume[mask] = std::min(known[mask]->bound, kept_volume[mask]);
     } else {

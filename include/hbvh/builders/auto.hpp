@@ -51,7 +51,7 @@ struct AutoOptions {
 
 /// Every member of auto_portfolio(n) builds a tree (through the registry, with its default options), in
 /// parallel, and the cheapest under Eq. 2 wins (first in the list on ties, whatever finished first). Up to
-/// auto_portfolio_max_primitives the winner then goes through the exact collapse: every inner node whose
+/// 2 000 primitives the winner then goes through the exact collapse: every inner node whose
 /// dissolution into its parent lowers Eq. 2 is dissolved (the best of every subset, docs/treelets.md §4).
 /// Deadline: the members share it — each gets what is left, and those that would start after it are
 /// skipped (the first always runs) — and refinement gets what remains, stopping between treelets.
