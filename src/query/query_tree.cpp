@@ -224,6 +224,13 @@ void QueryTree::finish() {
         }
         for (std::uint32_t c = q.first_child + q.child_count; c-- > q.first_child;) pending.push_back(c);
     }
+    if (leaves_.size() <= contact_order_max_leaves) {
+        // A stable bucket pass by kind, cheapest exact test first.
+        contact_order_.reserve(leaves_.size());
+        for (const BvType kind : {BvType::sphere, BvType::capsule, BvType::aabb, BvType::obb})
+            for (const std::uint32_t leaf : leaves_)
+                if (nodes_[leaf].type == kind) contact_order_.push_back(leaf);
+    }
     for (std::uint32_t i = static_cast<std::uint32_t>(nodes_.size()); i-- > 0;) {
         QueryNode& q = nodes_[i];
         if (q.child_count == 0) continue;

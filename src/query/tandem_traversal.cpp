@@ -25,6 +25,7 @@ using detail::Placed;
 constexpr double concentric_fraction = 0.5;
 constexpr std::uint64_t concentric_pair_limit_all = 1024;
 constexpr std::uint64_t concentric_pair_limit_first = 4096;
+static_assert(concentric_pair_limit_first <= QueryTree::contact_order_max_leaves);
 /// Above the limit, mode first still tries this many leaf pairs of concentric roots before it descends: where
 /// copies overlap, the first leaf of b nearly always meets one of a's first leaves (depth-first order keeps
 /// neighbours together), and a probe that finds nothing costs a bounded few leaf tests (docs/queries.md,
@@ -47,7 +48,12 @@ public:
             const bool first = mode_ == CollideMode::first;
             if (pairs <= (first ? concentric_pair_limit_first : concentric_pair_limit_all)) {
                 result_.nodes_visited = 1;
-                flat(na_[0], nb_[0]);
+                // Mode first: most pairs of such roots meet and any one answers, so the cheapest are tried
+                // first (each tree has at most concentric_pair_limit_first leaves, so it has its contact order).
+                if (first)
+                    all_pairs(a_.contact_order(), b_.contact_order());
+                else
+                    flat(na_[0], nb_[0]);
                 return;
             }
             if (first && probe_roots(concentric_probe_pairs)) return;
@@ -142,8 +148,11 @@ private:
 
     /// Every leaf of x against every leaf of y; true when the query is answered (mode first).
     bool flat(const QueryNode& x, const QueryNode& y) {
-        const std::span<const std::uint32_t> leaves_a = a_.leaves().subspan(x.leaf_begin, x.leaf_count);
-        const std::span<const std::uint32_t> leaves_b = b_.leaves().subspan(y.leaf_begin, y.leaf_count);
+        return all_pairs(a_.leaves().subspan(x.leaf_begin, x.leaf_count), b_.leaves().subspan(y.leaf_begin, y.leaf_count));
+    }
+
+    /// Every leaf of `leaves_a` against every leaf of `leaves_b`, b's outer; true when the query is answered.
+    bool all_pairs(std::span<const std::uint32_t> leaves_a, std::span<const std::uint32_t> leaves_b) {
         for (const std::uint32_t leaf_b : leaves_b) {
             const Vec3 center_b = moved_.center(leaf_b);
             for (const std::uint32_t leaf_a : leaves_a)

@@ -323,6 +323,49 @@ TEST(TandemTraversal, LargeConcentricRootsAreProbedLeafByLeafInModeFirst) {
     }
 }
 
+TEST(TandemTraversal, SmallConcentricRootsTryTheCheapestLeafPairsFirstInModeFirst) {
+    // Boxes, oriented boxes and capsules around one small sphere, listed first in no order of kind: on a
+    // copy of itself (concentric roots, few leaf pairs) mode first tests every leaf pair in contact order,
+    // so the sphere against its copy answers at the first leaf test, wherever the builder put it.
+    const Mat3 tilt = Eigen::AngleAxisd(0.4, Vec3(1, 1, 0).normalized()).toRotationMatrix();
+    std::vector<Primitive> primitives;
+    for (int i = 0; i < 12; ++i) {
+        const Vec3 at(std::cos(0.5 * i) * 2.0, std::sin(0.5 * i) * 2.0, 0.1 * i);
+        if (i % 3 == 0) primitives.push_back({Aabb{at - Vec3(0.5, 0.4, 0.3), at + Vec3(0.5, 0.4, 0.3)}, ""});
+        else if (i % 3 == 1) primitives.push_back({Obb{at, tilt, Vec3(0.6, 0.3, 0.2)}, ""});
+        else primitives.push_back({Capsule{at - Vec3(0.3, 0.0, 0.0), at + Vec3(0.3, 0.0, 0.0), 0.2}, ""});
+    }
+    primitives.push_back({Sphere{Vec3(0.0, 0.0, 0.6), 0.05}, ""});
+    const std::uint32_t sphere = static_cast<std::uint32_t>(primitives.size() - 1);
+    const Bvh bvh = build(primitives, Algorithm::split).value();
+    const QueryTree tree(bvh);
+
+    // The order holds every leaf once, kinds in the order of their exact test's cost.
+    std::vector<std::uint32_t> order(tree.contact_order().begin(), tree.contact_order().end());
+    std::vector<std::uint32_t> leaves(tree.leaves().begin(), tree.leaves().end());
+    std::sort(order.begin(), order.end());
+    std::sort(leaves.begin(), leaves.end());
+    EXPECT_EQ(order, leaves);
+    ASSERT_FALSE(tree.contact_order().empty());
+    EXPECT_EQ(tree.nodes()[tree.contact_order().front()].primitive, sphere);
+    ASSERT_NE(tree.leaves().front(), tree.contact_order().front());  // else the test would not tell the orders apart
+
+    const CollideResult first = collide(tree, RigidTransform::identity(), tree, RigidTransform::identity(), CollideMode::first);
+    ASSERT_EQ(first.pairs.size(), 1u);
+    EXPECT_EQ(first.pairs.front(), std::make_pair(sphere, sphere));
+    EXPECT_EQ(first.primitive_tests, 1u);
+
+    // Moved so that the spheres miss (and many other pairs do not): the answer is still a pair brute force finds.
+    const RigidTransform shifted{Eigen::AngleAxisd(0.3, Vec3(0, 0, 1)).toRotationMatrix(), Vec3(0.05, 0.0, 0.2)};
+    const Pairs all = brute_force(bvh, RigidTransform::identity(), bvh, shifted);
+    ASSERT_FALSE(all.empty());
+    ASSERT_FALSE(std::binary_search(all.begin(), all.end(), std::make_pair(sphere, sphere)));
+    const CollideResult moved = collide(tree, RigidTransform::identity(), tree, shifted, CollideMode::first);
+    ASSERT_EQ(moved.pairs.size(), 1u);
+    EXPECT_TRUE(std::binary_search(all.begin(), all.end(), moved.pairs.front()));
+    EXPECT_EQ(moved.bv_tests, 1u);  // the roots' test alone: the pairs were tested flat
+}
+
 TEST(TandemTraversal, MatchesBruteForceOnDeepMixedTrees) {
     const Work work = check_builder("deep-mixed", build_deep_mixed);
     // A real hierarchy must prune: far fewer primitive tests than the two-level method's all pairs.

@@ -104,6 +104,14 @@ public:
     /// Leaf node indices in depth-first order, so that every subtree's leaves are one contiguous range
     /// (QueryNode::leaf_begin, leaf_count): small node pairs are tested leaf by leaf from it.
     [[nodiscard]] std::span<const std::uint32_t> leaves() const { return leaves_; }
+    /// Trees of up to this many leaves also keep their leaves in contact_order().
+    static constexpr std::size_t contact_order_max_leaves = 4096;
+    /// The leaves (node indices) ordered by the cost of their exact test, cheapest first: spheres, capsules,
+    /// boxes, oriented boxes (measured: 6, 33, 40 and 48 ns for a moved leaf against its own copy), depth-first
+    /// within a kind. Where most leaf pairs meet and any contact answers the query (mode first on nearly
+    /// concentric roots), the cheapest pairs are worth trying first (docs/queries.md, "Concentric roots").
+    /// Empty for a tree of more than contact_order_max_leaves leaves.
+    [[nodiscard]] std::span<const std::uint32_t> contact_order() const { return contact_order_; }
     /// Largest |center|_1 of any node: with extent_bound(), what rounding in a box test is relative to.
     [[nodiscard]] double coordinate_bound() const { return coordinate_bound_; }
     /// Largest sum of a node's enclosing-box half extents.
@@ -136,6 +144,7 @@ private:
     std::vector<BoundingVolume> volumes_;
     std::vector<std::uint32_t> primitive_nodes_;
     std::vector<std::uint32_t> leaves_;
+    std::vector<std::uint32_t> contact_order_;
     std::uint32_t stack_bound_ = 0;
     double coordinate_bound_ = 0.0;
     double extent_bound_ = 0.0;
