@@ -39,7 +39,7 @@ struct QuickhullBuffers {
     std::vector<std::uint32_t> pending;
     std::vector<std::uint32_t> visible;
     std::vector<HorizonEdge> horizon;
-    std::vector<std::uint32_t> loop_vertices;
+    std::vector<std::uint32_t> vertex_stamp;
     std::vector<std::uint32_t> new_faces;
     std::vector<std::uint32_t> output_index;
 };
@@ -48,14 +48,14 @@ class Quickhull {
 public:
     Quickhull(std::span<const Vec3> points, QuickhullBuffers& buffers)
         : points_(points), faces_(buffers.faces), next_outside_(buffers.next_outside), pending_(buffers.pending),
-          visible_(buffers.visible), horizon_(buffers.horizon), loop_vertices_(buffers.loop_vertices),
+          visible_(buffers.visible), horizon_(buffers.horizon), vertex_stamp_(buffers.vertex_stamp),
           new_faces_(buffers.new_faces), output_index_(buffers.output_index) {
         faces_.clear();
         next_outside_.assign(points.size(), none);
         pending_.clear();
         visible_.clear();
         horizon_.clear();
-        loop_vertices_.clear();
+        vertex_stamp_.assign(points.size(), 0);
         new_faces_.clear();
     }
 
@@ -87,14 +87,15 @@ private:
         const Vec3 ab = points_[b] - points_[a];
         const Vec3 ac = points_[c] - points_[a];
         const Vec3 n = ab.cross(ac);
-        const double length = n.norm();
+        const double squared_length = n.squaredNorm();
         // |ab x ac| = |ab| |ac| sin(angle), and n's direction is off by about eps / sin(angle): a point at the
         // set's scale is then misplaced by up to 2 eps scale / sin. Above 1e-5 that stays under 5e-11 of the
         // scale; thinner triangles (a cluster of nanometres beside a far point, found by fuzz_collide) go to qhull.
-        if (!(length > 1e-5 * ab.norm() * ac.norm())) return std::nullopt;
+        // (Compared squared: one square root per face instead of three.)
+        if (!(squared_length > 1e-10 * ab.squaredNorm() * ac.squaredNorm())) return std::nullopt;
         Face face;
         face.vertex = {a, b, c};
-        face.normal = n / length;
+        face.normal = n / std::sqrt(squared_length);
         face.offset = face.normal.dot((points_[a] + points_[b] + points_[c]) / 3.0);
         faces_.push_back(face);
         return static_cast<std::uint32_t>(faces_.size() - 1);
@@ -225,13 +226,14 @@ private:
             return faces_[e.face].vertex[static_cast<std::size_t>((e.edge + 1) % 3)];
         };
         if (horizon_.size() < 3) return false;
-        loop_vertices_.clear();
+        // A vertex met twice is found by a stamp per point (one per step), not by sorting the loop.
+        ++step_;
         for (std::size_t i = 0; i < horizon_.size(); ++i) {
             if (head(horizon_[i]) != tail(horizon_[(i + 1) % horizon_.size()])) return false;
-            loop_vertices_.push_back(tail(horizon_[i]));
+            std::uint32_t& stamp = vertex_stamp_[tail(horizon_[i])];
+            if (stamp == step_) return false;
+            stamp = step_;
         }
-        std::sort(loop_vertices_.begin(), loop_vertices_.end());
-        if (std::adjacent_find(loop_vertices_.begin(), loop_vertices_.end()) != loop_vertices_.end()) return false;
 
         // The cone from the eye to the horizon.
         const std::uint32_t first_new = static_cast<std::uint32_t>(faces_.size());
@@ -286,8 +288,12 @@ private:
             }
             hull.neighbors.push_back(across);
         }
-        std::sort(hull.vertices.begin(), hull.vertices.end());
-        hull.vertices.erase(std::unique(hull.vertices.begin(), hull.vertices.end()), hull.vertices.end());
+        // The corners ascending, each once: marked per point, then collected in index order (no sort).
+        ++step_;
+        for (const std::uint32_t v : hull.vertices) vertex_stamp_[v] = step_;
+        hull.vertices.clear();
+        for (std::uint32_t p = 0; p < points_.size(); ++p)
+            if (vertex_stamp_[p] == step_) hull.vertices.push_back(p);
         // Euler's formula for a closed surface of triangles, V - E + F = 2 with E = 3F/2: F = 2V - 4.
         if (hull.triangles.size() != 2 * hull.vertices.size() - 4) return std::nullopt;
         return hull;
@@ -301,7 +307,8 @@ private:
     std::vector<std::uint32_t>& pending_;
     std::vector<std::uint32_t>& visible_;
     std::vector<HorizonEdge>& horizon_;
-    std::vector<std::uint32_t>& loop_vertices_;
+    std::vector<std::uint32_t>& vertex_stamp_;  ///< Per point: the last step_ that marked it.
+    std::uint32_t step_ = 0;
     std::vector<std::uint32_t>& new_faces_;
     std::vector<std::uint32_t>& output_index_;
 };
