@@ -125,10 +125,15 @@ BoundingVolume PrimitiveSet::fit(std::span<const std::uint32_t> locals) const {
 
 double PrimitiveSet::estimate(std::span<const std::uint32_t> locals) const {
     HBVH_ASSERT(!locals.empty());
-    std::vector<std::uint32_t> sorted(locals.begin(), locals.end());
+    // Per thread and kept: the builders call this for every candidate group, and fresh arrays were a tenth of
+    // auto's allocations (heaptrack on the ANYmal).
+    thread_local std::vector<std::uint32_t> sorted;
+    thread_local std::vector<Sphere> spheres;
+    thread_local std::vector<BoundingVolume> hints;
+    sorted.assign(locals.begin(), locals.end());
     std::sort(sorted.begin(), sorted.end());
-    std::vector<Sphere> spheres;
-    std::vector<BoundingVolume> hints;
+    spheres.clear();
+    hints.clear();
     for (const std::uint32_t local : sorted) {
         const std::span<const Sphere> own = this->spheres(local);
         spheres.insert(spheres.end(), own.begin(), own.end());

@@ -115,9 +115,9 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
     // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
     double radius = max_radius;
-    std::vector<Eigen::Vector2d> hull;
-    std::vector<EdgeExtremes> extremes;
-    OutlineScratch scratch;
+    thread_local std::vector<Eigen::Vector2d> hull;  // per thread and kept, as in face_flush_frames
+    thread_local std::vector<EdgeExtremes> extremes;
+    thread_local OutlineScratch scratch;
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
             const Mat3 basis = frame_from_axis(frame * local_normal);

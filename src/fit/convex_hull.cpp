@@ -45,6 +45,7 @@ double add_triangle(const Vec3& p, const Vec3& q, const Vec3& r, double& area_su
 std::vector<Vec3> distinct_normals(std::vector<std::pair<double, Vec3>> faces) {
     std::stable_sort(faces.begin(), faces.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     std::vector<Vec3> normals;
+    normals.reserve(std::min(faces.size(), max_face_normals));
     for (const auto& [area, normal] : faces) {
         if (normals.size() >= max_face_normals) break;
         const bool seen = std::any_of(normals.begin(), normals.end(),
@@ -126,10 +127,13 @@ HullSummary summary_of_triangles(std::span<const Vec3> points, const TriangleHul
     Mat3 second_moment = Mat3::Zero();
     std::vector<std::pair<double, Vec3>> faces;
     faces.reserve(hull.triangles.size());
-    std::vector<std::uint32_t> slot_of(points.size(), 0);
+    thread_local std::vector<std::uint32_t> slot_of;  // per thread and kept, as the quickhull's arrays
+    slot_of.assign(points.size(), 0);
     for (std::uint32_t slot = 0; slot < hull.vertices.size(); ++slot) slot_of[hull.vertices[slot]] = slot;
     HullSurface& surface = summary.surface;
     surface.neighbors = hull.neighbors;
+    surface.triangles.reserve(hull.triangles.size());
+    surface.normals.reserve(hull.triangles.size());
     for (const auto& [a, b, c] : hull.triangles) {
         const Vec3& p = points[a];
         const Vec3& q = points[b];
@@ -218,8 +222,8 @@ HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method) {
         Vec3 mean = Vec3::Zero();
         for (const Sphere& s : spheres) mean += s.center;
         mean /= static_cast<double>(spheres.size());
-        std::vector<Vec3> points;
-        points.reserve(spheres.size());
+        thread_local std::vector<Vec3> points;  // per thread and kept, as the quickhull's arrays
+        points.clear();
         for (const Sphere& s : spheres) points.push_back(s.center - mean);
         // Small sets by our own quickhull, which returns nothing whenever rounding could mislead it;
         // qhull, with its facet merging, takes those and the large sets.

@@ -232,7 +232,10 @@ void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origi
 SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull) {
     SphereProxy proxy;
     proxy.surface = hull.surface;
-    std::vector<bool> taken(spheres.size(), false);
+    thread_local std::vector<bool> taken;  // per thread and kept, as the quickhull's arrays
+    taken.assign(spheres.size(), false);
+    proxy.hull_points.reserve(hull.vertices.size());
+    proxy.spheres.reserve(spheres.size());
     for (std::uint32_t i : hull.vertices) {
         taken[i] = true;
         proxy.hull_points.push_back(spheres[i].center);
@@ -273,10 +276,11 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     std::vector<Mat3> frames;
     frames.reserve(normals.size());
     const double pad = 2.0 * proxy.max_radius;
-    OutlineScratch scratch;
-    std::vector<Eigen::Vector2d> hull;
-    std::vector<double> xs, ys;  // the hull's vertices in two arrays, for polygon_extent's lanes
-    std::vector<EdgeExtremes> extremes;
+    // Per thread and kept, like the quickhull's arrays: fresh ones were five allocations and their growth per fit.
+    thread_local OutlineScratch scratch;
+    thread_local std::vector<Eigen::Vector2d> hull;
+    thread_local std::vector<double> xs, ys;  // the hull's vertices in two arrays, for polygon_extent's lanes
+    thread_local std::vector<EdgeExtremes> extremes;
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
         hull_outline(proxy, basis, Vec3::Zero(), hull, scratch);

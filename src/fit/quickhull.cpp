@@ -273,6 +273,13 @@ private:
         TriangleHull hull;
         std::vector<std::uint32_t>& output_index = output_index_;
         output_index.assign(faces_.size(), none);
+        // Sized once: grown by push_back, these three arrays were about 25 allocations per call, a quarter of
+        // all of auto's allocations (heaptrack on the ANYmal).
+        const auto live = static_cast<std::size_t>(
+            std::count_if(faces_.begin(), faces_.end(), [](const Face& face) { return face.alive; }));
+        hull.triangles.reserve(live);
+        hull.neighbors.reserve(live);
+        hull.vertices.reserve(3 * live);
         for (std::uint32_t f = 0; f < faces_.size(); ++f) {
             if (!faces_[f].alive) continue;
             output_index[f] = static_cast<std::uint32_t>(hull.triangles.size());
