@@ -13,6 +13,7 @@
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "../memory/huge_pages.hpp"
+#include "../memory/thread_scratch.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -125,11 +126,12 @@ BoundingVolume PrimitiveSet::fit(std::span<const std::uint32_t> locals) const {
 
 double PrimitiveSet::estimate(std::span<const std::uint32_t> locals) const {
     HBVH_ASSERT(!locals.empty());
-    // Per thread and kept: the builders call this for every candidate group, and fresh arrays were a tenth of
-    // auto's allocations (heaptrack on the ANYmal).
+    // Per thread and kept (memory/thread_scratch.hpp): the builders call this for every candidate group, and fresh
+    // arrays were a tenth of auto's allocations (heaptrack on the ANYmal).
     thread_local std::vector<std::uint32_t> sorted;
     thread_local std::vector<Sphere> spheres;
     thread_local std::vector<BoundingVolume> hints;
+    const ReleaseIfLarge release(sorted, spheres, hints);
     sorted.assign(locals.begin(), locals.end());
     std::sort(sorted.begin(), sorted.end());
     spheres.clear();

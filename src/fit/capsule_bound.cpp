@@ -9,6 +9,7 @@
 #include <numbers>
 #include <vector>
 
+#include "../memory/thread_scratch.hpp"
 #include "hull_2d.hpp"
 
 namespace hbvh::detail {
@@ -115,9 +116,10 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     // Every sphere's centre lies in the hull of the hull points, and each sphere is at least min_radius
     // thick, so the set's width along u is at least the hull points' width plus 2 min_radius.
     double radius = max_radius;
-    thread_local std::vector<Eigen::Vector2d> hull;  // per thread and kept, as in face_flush_frames
+    thread_local std::vector<Eigen::Vector2d> hull;  // per thread and kept (memory/thread_scratch.hpp)
     thread_local std::vector<EdgeExtremes> extremes;
     thread_local OutlineScratch scratch;
+    const ReleaseIfLarge release(hull, extremes, scratch.outline, scratch.next_slot, scratch.facing, scratch.projected);
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
             const Mat3 basis = frame_from_axis(frame * local_normal);

@@ -14,6 +14,8 @@ extern "C" {
 #include <libqhull_r/qhull_ra.h>
 }
 
+#include "../memory/thread_scratch.hpp"
+
 namespace hbvh::detail {
 namespace {
 
@@ -127,7 +129,7 @@ HullSummary summary_of_triangles(std::span<const Vec3> points, const TriangleHul
     Mat3 second_moment = Mat3::Zero();
     std::vector<std::pair<double, Vec3>> faces;
     faces.reserve(hull.triangles.size());
-    thread_local std::vector<std::uint32_t> slot_of;  // per thread and kept, as the quickhull's arrays
+    thread_local std::vector<std::uint32_t> slot_of;  // per thread and kept; quickhull sets only, so at most 4 KiB
     slot_of.assign(points.size(), 0);
     for (std::uint32_t slot = 0; slot < hull.vertices.size(); ++slot) slot_of[hull.vertices[slot]] = slot;
     HullSurface& surface = summary.surface;
@@ -222,7 +224,8 @@ HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method) {
         Vec3 mean = Vec3::Zero();
         for (const Sphere& s : spheres) mean += s.center;
         mean /= static_cast<double>(spheres.size());
-        thread_local std::vector<Vec3> points;  // per thread and kept, as the quickhull's arrays
+        thread_local std::vector<Vec3> points;  // per thread and kept (memory/thread_scratch.hpp)
+        const ReleaseIfLarge release(points);
         points.clear();
         for (const Sphere& s : spheres) points.push_back(s.center - mean);
         // Small sets by our own quickhull, which returns nothing whenever rounding could mislead it;

@@ -11,6 +11,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "../memory/thread_scratch.hpp"
 #include "hull_2d.hpp"
 #include "rounding_pad.hpp"
 
@@ -232,7 +233,8 @@ void hull_outline(const SphereProxy& proxy, const Mat3& basis, const Vec3& origi
 SphereProxy make_proxy(std::span<const Sphere> spheres, const HullSummary& hull) {
     SphereProxy proxy;
     proxy.surface = hull.surface;
-    thread_local std::vector<bool> taken;  // per thread and kept, as the quickhull's arrays
+    thread_local std::vector<bool> taken;  // per thread and kept (memory/thread_scratch.hpp)
+    const ReleaseIfLarge release(taken);
     taken.assign(spheres.size(), false);
     proxy.hull_points.reserve(hull.vertices.size());
     proxy.spheres.reserve(spheres.size());
@@ -276,11 +278,13 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     std::vector<Mat3> frames;
     frames.reserve(normals.size());
     const double pad = 2.0 * proxy.max_radius;
-    // Per thread and kept, like the quickhull's arrays: fresh ones were five allocations and their growth per fit.
+    // Per thread and kept (memory/thread_scratch.hpp): fresh ones were five allocations and their growth per fit.
     thread_local OutlineScratch scratch;
     thread_local std::vector<Eigen::Vector2d> hull;
     thread_local std::vector<double> xs, ys;  // the hull's vertices in two arrays, for polygon_extent's lanes
     thread_local std::vector<EdgeExtremes> extremes;
+    const ReleaseIfLarge release(hull, xs, ys, extremes, scratch.outline, scratch.next_slot, scratch.facing,
+                                 scratch.projected);
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
         hull_outline(proxy, basis, Vec3::Zero(), hull, scratch);

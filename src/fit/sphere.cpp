@@ -22,15 +22,23 @@ using Kernel = CGAL::Simple_cartesian<double>;
 using Traits3 = CGAL::Min_sphere_of_spheres_d_traits_3<Kernel, double>;
 using Traits2 = CGAL::Min_sphere_of_spheres_d_traits_2<Kernel, double>;
 
-/// This thread's solver, emptied: a fresh one allocated its two arrays and their growth on every fit (about a
-/// fifth of auto's allocations, heaptrack on the ANYmal), a cleared one keeps their capacity. Clearing leaves
-/// nothing of the last solve that the next reads: with these inexact traits the farthest-first heuristic runs
-/// alone, never the randomised LP step whose generator would carry over, so the same spheres give the same ball.
-template <class Traits>
-CGAL::Min_sphere_of_spheres_d<Traits>& reused_solver() {
-    thread_local CGAL::Min_sphere_of_spheres_d<Traits> solver;
-    solver.clear();
-    return solver;
+/// Runs `solve` on an empty solver of these traits. Sets of up to kept_solver_size spheres get this thread's own
+/// solver, cleared: a fresh one allocated its two arrays and their growth on every fit (a fifth of auto's
+/// allocations, heaptrack on the ANYmal), a cleared one keeps their capacity. Clearing leaves nothing of the last
+/// solve that the next reads: with these inexact traits the farthest-first heuristic runs alone, never the
+/// randomised LP step whose generator would carry over, so the same spheres give the same ball. Larger sets get a
+/// fresh solver, so that no thread keeps a large one (memory/thread_scratch.hpp).
+constexpr std::size_t kept_solver_size = 4096;
+
+template <class Traits, class Solve>
+auto with_empty_solver(std::size_t count, Solve solve) {
+    if (count > kept_solver_size) {
+        CGAL::Min_sphere_of_spheres_d<Traits> fresh;
+        return solve(fresh);
+    }
+    thread_local CGAL::Min_sphere_of_spheres_d<Traits> kept;
+    kept.clear();
+    return solve(kept);
 }
 
 }  // namespace
@@ -49,16 +57,17 @@ Sphere fit_sphere(std::span<const Sphere> spheres) {
     const Vec3 origin = 0.5 * (low + high);
     const double span = std::max((high - low).maxCoeff(), largest_radius);
     const double scale = span > 0.0 ? span : 1.0;
-    CGAL::Min_sphere_of_spheres_d<Traits3>& solver = reused_solver<Traits3>();
-    for (const Sphere& s : spheres) {
-        const Vec3 c = (s.center - origin) / scale;
-        solver.insert(Traits3::Sphere(Kernel::Point_3(c.x(), c.y(), c.z()), s.radius / scale));
-    }
-
-    Sphere result;
-    auto coordinate = solver.center_cartesian_begin();
-    for (int k = 0; k < 3; ++k, ++coordinate) result.center[k] = *coordinate * scale + origin[k];
-    result.radius = solver.radius() * scale;
+    Sphere result = with_empty_solver<Traits3>(spheres.size(), [&](CGAL::Min_sphere_of_spheres_d<Traits3>& solver) {
+        for (const Sphere& s : spheres) {
+            const Vec3 c = (s.center - origin) / scale;
+            solver.insert(Traits3::Sphere(Kernel::Point_3(c.x(), c.y(), c.z()), s.radius / scale));
+        }
+        Sphere ball;
+        auto coordinate = solver.center_cartesian_begin();
+        for (int k = 0; k < 3; ++k, ++coordinate) ball.center[k] = *coordinate * scale + origin[k];
+        ball.radius = solver.radius() * scale;
+        return ball;
+    });
     // CGAL's answer is optimal up to rounding; measure containment the way Sphere::contains does and grow.
     for (const Sphere& s : spheres) result.radius = std::max(result.radius, (s.center - result.center).norm() + s.radius);
     // The distances are of nearby points, so their rounding scales with the radius, not the coordinates.
@@ -70,15 +79,16 @@ namespace detail {
 
 Circle min_circle_of_circles(std::span<const Circle> circles) {
     HBVH_ASSERT(!circles.empty());
-    CGAL::Min_sphere_of_spheres_d<Traits2>& solver = reused_solver<Traits2>();
-    for (const Circle& c : circles) solver.insert(Traits2::Sphere(Kernel::Point_2(c.center.x(), c.center.y()), c.radius));
-
-    Circle result;
-    auto coordinate = solver.center_cartesian_begin();
-    result.center.x() = *coordinate;
-    ++coordinate;
-    result.center.y() = *coordinate;
-    result.radius = solver.radius();
+    Circle result = with_empty_solver<Traits2>(circles.size(), [&](CGAL::Min_sphere_of_spheres_d<Traits2>& solver) {
+        for (const Circle& c : circles) solver.insert(Traits2::Sphere(Kernel::Point_2(c.center.x(), c.center.y()), c.radius));
+        Circle circle;
+        auto coordinate = solver.center_cartesian_begin();
+        circle.center.x() = *coordinate;
+        ++coordinate;
+        circle.center.y() = *coordinate;
+        circle.radius = solver.radius();
+        return circle;
+    });
     for (const Circle& c : circles) result.radius = std::max(result.radius, (c.center - result.center).norm() + c.radius);
     return result;
 }
