@@ -229,10 +229,16 @@ HullSummary summarize_hull(std::span<const Sphere> spheres, HullMethod method) {
         points.clear();
         for (const Sphere& s : spheres) points.push_back(s.center - mean);
         // Small sets by our own quickhull, which returns nothing whenever rounding could mislead it;
-        // qhull, with its facet merging, takes those and the large sets.
+        // qhull, with its facet merging, takes those and the large sets, except sets flat within rounding,
+        // where it can find no solid either (docs/fitting.md, "Flat sets without qhull").
         std::optional<TriangleHull> triangles;
-        if (method == HullMethod::automatic && points.size() <= quickhull_max_points) triangles = quickhull(points);
-        summary = triangles ? summary_of_triangles(points, *triangles) : summary_by_qhull(points);
+        bool flat_within_rounding = false;
+        if (method == HullMethod::automatic && points.size() <= quickhull_max_points)
+            triangles = quickhull(points, &flat_within_rounding);
+        if (triangles)
+            summary = summary_of_triangles(points, *triangles);
+        else if (!flat_within_rounding)
+            summary = summary_by_qhull(points);
     }
     if (!summary.is_solid) {
         // Flat boxes, collinear points, duplicates: no 3-D hull, so use the raw centres.

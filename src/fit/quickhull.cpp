@@ -59,6 +59,9 @@ public:
         new_faces_.clear();
     }
 
+    /// After run() returned nothing: whether that was because the points are flat beyond doubt.
+    [[nodiscard]] bool flat_within_rounding() const { return flat_within_rounding_; }
+
     std::optional<TriangleHull> run() {
         if (points_.size() < 4) return std::nullopt;
         double scale = 0.0;
@@ -66,6 +69,7 @@ public:
         // Rounding in a plane distance is a few ulps of the coordinates; points this close to a plane are
         // on it. The same threshold decides whether the points span a solid at all.
         tolerance_ = 1e-12 * scale;
+        if (scale == 0.0) flat_within_rounding_ = true;  // every point the same
         if (!(tolerance_ > 0.0) || !std::isfinite(tolerance_)) return std::nullopt;
         if (!make_simplex()) return std::nullopt;
         while (!pending_.empty()) {
@@ -115,6 +119,15 @@ private:
         return false;
     }
 
+    /// make_simplex's refusal of points whose extent across the plane (or line, or point) of the simplex so far is
+    /// `across`, no more than the tolerance: noted as flat beyond doubt when it is within 1e-15 of the scale, about
+    /// four units in the last place of the coordinates, where no program can find a solid (qhull found none in the
+    /// 3 800 such sets of docs/fitting.md, "Flat sets without qhull").
+    bool refuse_as_flat(double across) {
+        flat_within_rounding_ = across <= 1e-3 * tolerance_;
+        return false;
+    }
+
     /// The first tetrahedron, from the extreme points; false when the points are flat within the tolerance.
     bool make_simplex() {
         std::array<std::uint32_t, 6> extreme{};
@@ -128,7 +141,7 @@ private:
         for (std::uint32_t a : extreme)
             for (std::uint32_t b : extreme)
                 if (const double d = (points_[a] - points_[b]).squaredNorm(); d > widest) widest = d, i0 = a, i1 = b;
-        if (!(std::sqrt(widest) > tolerance_)) return false;
+        if (!(std::sqrt(widest) > tolerance_)) return refuse_as_flat(std::sqrt(widest));
         const Vec3 u = (points_[i1] - points_[i0]).normalized();
         std::uint32_t i2 = i0;
         double off_line = 0.0;
@@ -136,7 +149,7 @@ private:
             const Vec3 d = points_[i] - points_[i0];
             if (const double s = (d - d.dot(u) * u).norm(); s > off_line) off_line = s, i2 = i;
         }
-        if (!(off_line > tolerance_)) return false;
+        if (!(off_line > tolerance_)) return refuse_as_flat(off_line);
         const Vec3 u1 = points_[i1] - points_[i0];
         const Vec3 u2 = points_[i2] - points_[i0];
         const Vec3 n = u1.cross(u2).normalized();
@@ -144,7 +157,7 @@ private:
         double off_plane = 0.0;
         for (std::uint32_t i = 0; i < points_.size(); ++i)
             if (const double s = std::abs(n.dot(points_[i] - points_[i0])); s > off_plane) off_plane = s, i3 = i;
-        if (!(off_plane > tolerance_)) return false;
+        if (!(off_plane > tolerance_)) return refuse_as_flat(off_plane);
 
         // One orientation for the whole tetrahedron, from one determinant whose sign must be beyond rounding
         // (its error is a few eps |u1| |u2| |u3|); the faces then take their vertex order from it, so every
@@ -309,6 +322,7 @@ private:
     std::span<const Vec3> points_;
     double tolerance_ = 0.0;
     bool linked_ = true;  ///< Cleared when two neighbours disagree about their shared edge.
+    bool flat_within_rounding_ = false;  ///< Refused because the points lie within rounding of a plane.
     std::vector<Face>& faces_;
     std::vector<std::uint32_t>& next_outside_;
     std::vector<std::uint32_t>& pending_;
@@ -322,12 +336,15 @@ private:
 
 }  // namespace
 
-std::optional<TriangleHull> quickhull(std::span<const Vec3> points) {
+std::optional<TriangleHull> quickhull(std::span<const Vec3> points, bool* flat_within_rounding) {
     // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel: half the
     // page faults of auto over the MuJoCo cards, and a tenth of its time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
     // largest hull that thread has built (at most quickhull_max_points points) and stay there.
     thread_local QuickhullBuffers buffers;
-    return Quickhull(points, buffers).run();
+    Quickhull hull(points, buffers);
+    std::optional<TriangleHull> result = hull.run();
+    if (flat_within_rounding != nullptr) *flat_within_rounding = !result && hull.flat_within_rounding();
+    return result;
 }
 
 }  // namespace hbvh::detail

@@ -30,6 +30,9 @@ struct TriangleHull {
 /// that tolerance) or when rounding made a step inconsistent (a visible region whose horizon is not one
 /// loop, a sliver triangle, a surface that is not a closed triangulated sphere): the caller then asks qhull,
 /// which merges facets to handle exactly those cases. Every returned hull has passed those checks.
-[[nodiscard]] std::optional<TriangleHull> quickhull(std::span<const Vec3> points);
+/// `flat_within_rounding`, when given, tells the first kind of refusal apart: it is set when the points lie
+/// within 1e-15 of that scale (a few units in the last place of the coordinates) of one plane, line or point,
+/// where qhull cannot find a solid either and need not be asked.
+[[nodiscard]] std::optional<TriangleHull> quickhull(std::span<const Vec3> points, bool* flat_within_rounding = nullptr);
 
 }  // namespace hbvh::detail

@@ -200,6 +200,66 @@ TEST(Quickhull, DeclinesWhatSpansNoSolid) {
     EXPECT_EQ(summary.vertices.size(), flat.size());
 }
 
+/// Points in a random plane (or on a line, or one point), each pushed off it by `thickness` times the set's
+/// size in a random direction: `thickness` 0 leaves only the rounding of the rotation.
+std::vector<Vec3> nearly_flat(SplitMix64& rng, int dimension, double thickness, std::size_t count) {
+    const Mat3 turn = rng.rotation();
+    const Vec3 offset(rng.uniform(-5, 5), rng.uniform(-5, 5), rng.uniform(-5, 5));
+    std::vector<Vec3> points;
+    for (std::size_t i = 0; i < count; ++i) {
+        const Vec3 in_span(dimension >= 1 ? rng.uniform(-1, 1) : 0.0, dimension >= 2 ? rng.uniform(-1, 1) : 0.0, 0.0);
+        const Vec3 off(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+        points.push_back(offset + turn * in_span + thickness * off);
+    }
+    return points;
+}
+
+// summarize_hull skips qhull for the sets the quickhull refuses as flat within rounding, so the flag must never be
+// set on a set qhull would find a solid in. Oracle: qhull itself (HullMethod::qhull), on points and lines and planes
+// whose thickness runs from exact through rounding to well above it; and the flag must be clear where the points
+// are thin but measurably solid, where qhull still has the last word.
+TEST(Quickhull, FlatWithinRoundingOnlyWhereQhullFindsNoSolidEither) {
+    SplitMix64 rng(2026);
+    int flagged = 0, left_to_qhull = 0;
+    for (int dimension = 0; dimension <= 2; ++dimension)
+        for (const double thickness : {0.0, 1e-17, 1e-16, 1e-15, 1e-14, 1e-13, 1e-12, 1e-9})
+            for (int trial = 0; trial < 20; ++trial) {
+                const std::vector<Vec3> raw = nearly_flat(rng, dimension, thickness, 4 + rng.below(40));
+                // As summarize_hull passes them: centred.
+                Vec3 mean = Vec3::Zero();
+                for (const Vec3& p : raw) mean += p;
+                mean /= static_cast<double>(raw.size());
+                std::vector<Vec3> points;
+                for (const Vec3& p : raw) points.push_back(p - mean);
+                bool flat = false;
+                const std::optional<TriangleHull> hull = detail::quickhull(points, &flat);
+                if (hull) {
+                    EXPECT_FALSE(flat);
+                    continue;
+                }
+                const bool qhull_solid = detail::summarize_hull(as_spheres(points), detail::HullMethod::qhull).is_solid;
+                if (flat) {
+                    ++flagged;
+                    EXPECT_FALSE(qhull_solid) << "dimension " << dimension << ", thickness " << thickness;
+                } else {
+                    ++left_to_qhull;
+                }
+            }
+    // Both kinds of refusal occur, so the test tells them apart.
+    EXPECT_GT(flagged, 100);
+    EXPECT_GT(left_to_qhull, 10);
+
+    // Exactly flat sets are flagged, and summarize_hull still falls back to every centre.
+    std::vector<Vec3> plane = nearly_flat(rng, 2, 0.0, 30);
+    for (Vec3& p : plane) p.z() = 0.25;
+    bool flat = false;
+    EXPECT_FALSE(detail::quickhull(plane, &flat).has_value());
+    EXPECT_TRUE(flat);
+    const detail::HullSummary summary = detail::summarize_hull(as_spheres(plane));
+    EXPECT_FALSE(summary.is_solid);
+    EXPECT_EQ(summary.vertices.size(), plane.size());
+}
+
 /// The points fuzz_collide found crashing the hull (a neighbour left unlinked): a box 2e-9 wide beside one point
 /// 1.4 away, as summarize_hull centres them. Declining is allowed; a hull must be one.
 TEST(Quickhull, TinyBoxBesideAFarPoint) {
