@@ -122,7 +122,7 @@ private:
     /// make_simplex's refusal of points whose extent across the plane (or line, or point) of the simplex so far is
     /// `across`, no more than the tolerance: noted as flat beyond doubt when it is within 1e-15 of the scale, about
     /// four units in the last place of the coordinates, where no program can find a solid (qhull found none in the
-    /// 3 800 such sets of docs/fitting.md, "Flat sets without qhull").
+    /// 3 924 such sets of docs/fitting.md, "Flat sets without qhull").
     bool refuse_as_flat(double across) {
         flat_within_rounding_ = across <= 1e-3 * tolerance_;
         return false;
