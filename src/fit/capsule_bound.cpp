@@ -119,7 +119,7 @@ double capsule_volume_lower_bound(const SphereProxy& proxy, std::span<const Mat3
     thread_local std::vector<Eigen::Vector2d> hull;  // per thread and kept (memory/thread_scratch.hpp)
     thread_local std::vector<EdgeExtremes> extremes;
     thread_local OutlineScratch scratch;
-    const ReleaseIfLarge release(hull, extremes, scratch.outline, scratch.next_slot, scratch.facing, scratch.projected);
+    const ReleaseIfLarge release(hull, extremes, scratch);
     for (const Mat3& frame : planes)
         for (const Vec3& local_normal : plane_normals()) {
             const Mat3 basis = frame_from_axis(frame * local_normal);

@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "../memory/thread_scratch.hpp"
 #include "hbvh/geometry/sphere.hpp"
 
 namespace hbvh::detail {
@@ -57,6 +58,15 @@ struct OutlineScratch {
     std::vector<unsigned char> facing;     ///< Per triangle, whether it faces the direction.
     std::vector<Eigen::Vector2d> projected;
 };
+
+/// Gives back whichever of the scratch's arrays one call grew large (memory/thread_scratch.hpp), so that a
+/// per-thread OutlineScratch can be handed to ReleaseIfLarge like any array.
+inline void release_if_large(OutlineScratch& scratch) {
+    release_if_large(scratch.outline);
+    release_if_large(scratch.next_slot);
+    release_if_large(scratch.facing);
+    release_if_large(scratch.projected);
+}
 
 /// The outline of `surface` seen along `direction`, into scratch.outline: the loop of edges between the
 /// triangles that face `direction` and those that do not (faces within 1e-9 of parallel to it count as not

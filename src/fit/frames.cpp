@@ -283,8 +283,7 @@ std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Ve
     thread_local std::vector<Eigen::Vector2d> hull;
     thread_local std::vector<double> xs, ys;  // the hull's vertices in two arrays, for polygon_extent's lanes
     thread_local std::vector<EdgeExtremes> extremes;
-    const ReleaseIfLarge release(hull, xs, ys, extremes, scratch.outline, scratch.next_slot, scratch.facing,
-                                 scratch.projected);
+    const ReleaseIfLarge release(hull, xs, ys, extremes, scratch);
     for (const Vec3& normal : normals) {
         const Mat3 basis = frame_from_axis(normal);
         hull_outline(proxy, basis, Vec3::Zero(), hull, scratch);
