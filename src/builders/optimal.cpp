@@ -1,16 +1,6 @@
 // SPDX-License-Identifier: MIT
-// The subset DP behind build_optimal (docs/solver.md §2).
-//
-// Eq. 2 charges an inner node over S with k children k·vol(S). So with best(S) the cheapest subtree over
-// S (0 for a single primitive) and P_k(S) the cheapest sum of best() over a partition of S into exactly k
-// blocks,
-//     best(S)  = min_{k >= 2} k·vol(S) + P_k(S)
-//     P_1(S)   = best(S)
-//     P_k(S)   = min over blocks B with min(S) ∈ B ⊊ S of best(B) + P_{k-1}(S \ B)     (k >= 2)
-// Fixing the block that holds the lowest element enumerates every partition exactly once. Pairs (S, B)
-// number (3^n - 1)/2, each with an inner loop over k <= |S \ B|, so the time is O(n·3^n) worst case and
-// about (n/3)·3^n/2 in practice; memory is n·2^n doubles. Subsets are visited in increasing integer
-// order, which lists every proper subset before its superset.
+// build_optimal: the subset DP of optimal_dp.cpp over fit_best's volume of every subset of the primitives, the
+// volumes fitted on demand (docs/solver.md §2).
 #include "hbvh/builders/optimal.hpp"
 #include "optimal_plan.hpp"
 
@@ -21,125 +11,95 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <limits>
+#include <optional>
 #include <string>
+#include <utility>
 
 #include "guarded_build.hpp"
-#include "hbvh/assert.hpp"
 #include "hbvh/builders/bnb_exact.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "treelet_bounds.hpp"
 
 namespace hbvh {
 namespace {
 
-constexpr double infinite_cost = std::numeric_limits<double>::infinity();
+/// Fits on demand: the first round fits this fraction of all subsets (the unfitted ones through which the
+/// cheapest trees over the current volumes pass), and each further round this factor times as many: a DP round
+/// at 17 primitives costs about what 10 000 fits do, so few large rounds beat many small ones (measured in
+/// docs/solver.md §2). A round that would fit half the unfitted subsets or more fits them all.
+constexpr double first_round_fraction = 0.1;
+constexpr double round_growth = 3.0;
 
-/// The tables of the DP.
-struct Tables {
-    std::uint32_t count = 0;
-    std::vector<double> best;           // best(S)
-    std::vector<double> parts;          // P_k(S) at parts[S * count + k - 1], k = 1..|S|
-    std::vector<std::uint8_t> children; // argmin k of best(S)
+/// The bits of `mask`, ascending: the covered primitives' input indices.
+std::vector<std::uint32_t> members_of(std::uint32_t mask) {
+    std::vector<std::uint32_t> out;
+    for (std::uint32_t m = mask; m != 0; m &= m - 1u) out.push_back(static_cast<std::uint32_t>(std::countr_zero(m)));
+    return out;
+}
 
-    [[nodiscard]] const double* row(std::uint32_t s) const { return parts.data() + std::size_t{s} * count; }
-    [[nodiscard]] double* row(std::uint32_t s) { return parts.data() + std::size_t{s} * count; }
-};
-
-Tables run_dp(std::uint32_t count, std::span<const double> volume) {
-    Tables t;
-    t.count = count;
+/// A lower bound of the weighted volume of every subset of two or more primitives (treelet_bounds.hpp), made
+/// a size at a time from the bound of the subset without its lowest member and that member's: each size's in
+/// parallel, each entry depending on its subset only. Only the previous size's hull points are kept.
+std::vector<double> subset_bounds(std::span<const Primitive> primitives, std::uint32_t count, double scale,
+                                  const std::vector<std::vector<std::uint32_t>>& by_size,
+                                  const detail::Checkpoint& checkpoint) {
     const std::uint32_t subsets = 1u << count;
-    t.best.assign(subsets, 0.0);
-    t.parts.assign(std::size_t{subsets} * count, infinite_cost);
-    t.children.assign(subsets, 0);
-    for (std::uint32_t s = 1; s < subsets; ++s) {
-        double* row = t.row(s);
-        const auto size = static_cast<std::uint32_t>(std::popcount(s));
-        if (size == 1) {
-            row[0] = 0.0;  // a single primitive is a leaf: no cost
-            continue;
-        }
-        // P_k(S), k >= 2: the block B holding the lowest element, the rest R partitioned into k-1 blocks.
-        const std::uint32_t low = s & (~s + 1u);
-        const std::uint32_t rest = s ^ low;
-        for (std::uint32_t sub = (rest - 1u) & rest;; sub = (sub - 1u) & rest) {
-            const std::uint32_t block = low | sub;
-            const std::uint32_t remainder = s ^ block;
-            const double block_cost = t.best[block];
-            const double* from = t.row(remainder);
-            const auto remainder_size = static_cast<std::uint32_t>(std::popcount(remainder));
-            for (std::uint32_t k = 0; k < remainder_size; ++k) row[k + 1] = std::min(row[k + 1], block_cost + from[k]);
-            if (sub == 0) break;
-        }
-        // best(S) = min over k >= 2 of k·vol(S) + P_k(S); the first (smallest) k wins ties.
-        const double w = volume[s];
-        double best = infinite_cost;
-        std::uint8_t arg = 0;
-        for (std::uint32_t k = 2; k <= size; ++k) {
-            const double candidate = static_cast<double>(k) * w + row[k - 1];
-            if (candidate < best) {
-                best = candidate;
-                arg = static_cast<std::uint8_t>(k);
-            }
-        }
-        t.best[s] = best;
-        t.children[s] = arg;
-        row[0] = best;
+    std::vector<double> bound(subsets, 0.0);
+    std::vector<detail::SetBound> made(subsets);
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const std::uint32_t single[] = {i};
+        made[1u << i] = detail::bound_set(primitives, single, scale);
     }
-    return t;
+    for (std::uint32_t size = 2; size <= count; ++size) {
+        checkpoint.step(0.0);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, by_size[size].size(), 64),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                                  const std::uint32_t mask = by_size[size][j];
+                                  const std::uint32_t rest = mask & (mask - 1u);
+                                  const std::uint32_t lowest = mask & ~rest;
+                                  const std::uint32_t lowest_index[] = {
+                                      static_cast<std::uint32_t>(std::countr_zero(lowest))};
+                                  made[mask] = detail::bound_union(primitives, made[rest], members_of(rest),
+                                                                   made[lowest], lowest_index, scale);
+                                  bound[mask] = made[mask].bound;
+                              }
+                          });
+        if (size > 2)  // the previous size's points are no longer needed (singletons are kept)
+            for (std::uint32_t mask : by_size[size - 1]) made[mask] = {};
+    }
+    return bound;
 }
 
-/// Splits S into the k blocks that realise P_k(S): the same sums as run_dp, so equality is exact.
-std::vector<std::uint32_t> blocks_of(const Tables& t, std::uint32_t s, std::uint32_t k) {
-    std::vector<std::uint32_t> blocks;
-    while (k > 1) {
-        const double target = t.row(s)[k - 1];
-        const std::uint32_t low = s & (~s + 1u);
-        const std::uint32_t rest = s ^ low;
-        std::uint32_t chosen = 0;
-        for (std::uint32_t sub = (rest - 1u) & rest;; sub = (sub - 1u) & rest) {
-            const std::uint32_t block = low | sub;
-            if (std::popcount(s ^ block) >= static_cast<int>(k - 1) && t.best[block] + t.row(s ^ block)[k - 2] == target) {
-                chosen = block;
-                break;
-            }
-            if (sub == 0) break;
-        }
-        HBVH_ASSERT(chosen != 0);
-        blocks.push_back(chosen);
-        s ^= chosen;
-        --k;
+/// The `wanted` unfitted subsets through which the cheapest trees pass under the current volumes (tables.best +
+/// the outside cost; ties by mask), and the plan's unfitted groups; ascending.
+std::vector<std::uint32_t> next_fits(const detail::SubsetTables& tables, std::span<const double> volume,
+                                     const std::vector<std::vector<std::uint32_t>>& by_size,
+                                     const std::vector<std::optional<BoundingVolume>>& fitted,
+                                     const OptimalPlan& plan, std::size_t wanted) {
+    std::vector<std::pair<double, std::uint32_t>> ranked;
+    for (std::size_t size = 2; size < by_size.size(); ++size)
+        for (std::uint32_t mask : by_size[size])
+            if (!fitted[mask]) ranked.emplace_back(0.0, mask);
+    std::vector<std::uint32_t> out;
+    if (2 * wanted >= ranked.size()) {
+        for (const auto& entry : ranked) out.push_back(entry.second);
+    } else {
+        const std::vector<double> outside = detail::cost_outside(tables, volume);
+        for (auto& [through, mask] : ranked) through = tables.best[mask] + outside[mask];
+        std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(wanted), ranked.end());
+        for (std::size_t j = 0; j < wanted; ++j) out.push_back(ranked[j].second);
+        for (const OptimalGroup& group : plan.groups)  // through them runs the cheapest tree, but ties may hide them
+            if (!fitted[group.covered]) out.push_back(group.covered);
     }
-    blocks.push_back(s);
-    return blocks;
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
 }
 
-}  // namespace
-
-OptimalPlan solve_optimal_hierarchy(std::uint32_t count, std::span<const double> subset_volume) {
-    HBVH_ASSERT(count >= 1 && count <= optimal_hard_limit);
-    HBVH_ASSERT(subset_volume.size() == (std::size_t{1} << count));
-    OptimalPlan plan;
-    if (count == 1) return plan;
-    const Tables t = run_dp(count, subset_volume);
-    const std::uint32_t full = (1u << count) - 1u;
-    plan.cost = t.best[full];
-    // Breadth-first, so parents precede children.
-    std::vector<std::uint32_t> queue{full};
-    for (std::size_t i = 0; i < queue.size(); ++i) {
-        const std::uint32_t s = queue[i];
-        OptimalGroup group{s, blocks_of(t, s, t.children[s])};
-        std::sort(group.children.begin(), group.children.end());
-        for (std::uint32_t child : group.children)
-            if (std::popcount(child) > 1) queue.push_back(child);
-        plan.groups.push_back(std::move(group));
-    }
-    return plan;
-}
-
-namespace {
 Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildContext& context, std::uint32_t limit,
                          const detail::Checkpoint& checkpoint);
+
 }  // namespace
 
 Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildContext& context,
@@ -163,7 +123,9 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildCont
     });
 }
 
+
 namespace {
+
 Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildContext& context, std::uint32_t limit,
                          const detail::Checkpoint& checkpoint) {
     const auto start = std::chrono::steady_clock::now();
@@ -178,31 +140,61 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
     for (std::uint32_t i = 0; i < count; ++i) leaves[i] = assembler.add_leaf(i);
     if (count == 1) return std::move(assembler).finish(leaves.front());
 
-    // Stage 1: the weighted volume of fit_best over every subset of two or more primitives. Each entry
-    // depends on its subset only, so the parallel loop is deterministic for any thread count.
-    auto fit_subset = [&](std::uint32_t mask) {
-        FitInput input;
-        for (std::uint32_t i = 0; i < count; ++i)
-            if (mask >> i & 1u) input.add(primitives[i].volume);
-        return fit_best(input.spheres, policy, input.hint_axes);
+    const std::uint32_t subsets = 1u << count;
+    const std::vector<std::vector<std::uint32_t>> by_size = detail::masks_by_size(count);
+    std::vector<double> volume(subsets, 0.0);
+    std::vector<std::optional<BoundingVolume>> fitted(subsets);
+    std::uint64_t fits = 0, solves = 0;
+    // fit_best over the primitives of each of `masks`, with FitInput over them in input order (as two-level
+    // does), in parallel: each entry depends on its subset only, so nothing depends on the thread count.
+    const auto fit_masks = [&](std::span<const std::uint32_t> masks) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 16),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              checkpoint.step(static_cast<double>(fits + range.begin()));  // approximate progress
+                              for (std::size_t j = range.begin(); j != range.end(); ++j) {
+                                  FitInput input;
+                                  for (std::uint32_t i : members_of(masks[j])) input.add(primitives[i].volume);
+                                  fitted[masks[j]] = fit_best(input.spheres, policy, input.hint_axes);
+                                  volume[masks[j]] = policy.weighted_volume(*fitted[masks[j]]);
+                              }
+                          });
+        fits += masks.size();
     };
-    std::vector<double> volume(std::size_t{1} << count, 0.0);
-    tbb::parallel_for(tbb::blocked_range<std::uint32_t>(1, 1u << count, 512),
-                      [&](const tbb::blocked_range<std::uint32_t>& range) {
-                          checkpoint.step(range.begin());  // blocks in any order: progress is approximate
-                          for (std::uint32_t mask = range.begin(); mask != range.end(); ++mask)
-                              if (std::popcount(mask) > 1) volume[mask] = policy.weighted_volume(fit_subset(mask));
-                      });
 
-    checkpoint.step(static_cast<double>(1u << count));
-    // Stage 2: the DP, then the tree it chose (children before parents for the assembler).
-    const OptimalPlan plan = solve_optimal_hierarchy(count, volume);
-    std::vector<std::uint32_t> id_of(std::size_t{1} << count, 0);
+    // The subset volumes. Where boxes or capsules are allowed a fit costs far more than a bound, and subsets are
+    // fitted on demand: every subset stands in by a lower bound of its weighted volume until it is fitted, and
+    // each round fits the unfitted subsets the cheapest trees pass through, until the DP's optimum uses fitted
+    // subsets only. That optimum is the optimum over all fits (every other tree costs at least its bounds), so
+    // the tree is the one of fitting every subset, up to a choice between trees of exactly equal cost.
+    if (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule)) {
+        volume = subset_bounds(primitives, count, detail::bound_scale(policy), by_size, checkpoint);
+    } else {
+        std::vector<std::uint32_t> all;
+        for (std::uint32_t size = 2; size <= count; ++size) all.insert(all.end(), by_size[size].begin(), by_size[size].end());
+        fit_masks(all);
+    }
+    double wanted = first_round_fraction * static_cast<double>(subsets);
+    OptimalPlan plan;
+    for (;;) {
+        checkpoint.step(static_cast<double>(fits));
+        const detail::SubsetTables tables = detail::solve_subsets(count, volume);
+        ++solves;
+        plan = detail::plan_of(tables);
+        const bool complete = std::all_of(plan.groups.begin(), plan.groups.end(),
+                                          [&](const OptimalGroup& group) { return fitted[group.covered].has_value(); });
+        if (complete) break;
+        fit_masks(next_fits(tables, volume, by_size, fitted, plan, static_cast<std::size_t>(wanted)));
+        wanted *= round_growth;
+    }
+
+    checkpoint.step(static_cast<double>(subsets));
+    // The tree the DP chose (children before parents for the assembler).
+    std::vector<std::uint32_t> id_of(subsets, 0);
     for (std::uint32_t i = 0; i < count; ++i) id_of[1u << i] = leaves[i];
     for (auto it = plan.groups.rbegin(); it != plan.groups.rend(); ++it) {
         std::vector<std::uint32_t> children;
         for (std::uint32_t child : it->children) children.push_back(id_of[child]);
-        id_of[it->covered] = assembler.add_group(children, fit_subset(it->covered));
+        id_of[it->covered] = assembler.add_group(children, std::move(*fitted[it->covered]));
     }
     if (report != nullptr) {
         LevelReport level;
@@ -211,10 +203,11 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         level.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         report->levels.push_back(level);
         report->lower_bound = plan.cost;
-        report->notes.push_back("optimal: subset DP over " + std::to_string((1u << count) - count - 1) + " fitted subsets");
+        report->notes.push_back("optimal: subset DP over " + std::to_string(subsets - count - 1) + " subsets, " +
+                                std::to_string(fits) + " of them fitted, " + std::to_string(solves) + " DP rounds");
     }
-    return std::move(assembler).finish(id_of[(1u << count) - 1u]);
+    return std::move(assembler).finish(id_of[subsets - 1u]);
 }
-}  // namespace
 
+}  // namespace
 }  // namespace hbvh

@@ -7,9 +7,12 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <filesystem>
+#include <functional>
 #include <map>
 
 #include "support/test_helpers.hpp"
+#include "hbvh/io/xml.hpp"
 #include "hbvh/builders/build.hpp"
 #include "builders/optimal_plan.hpp"
 #include "hbvh/builders/optimal.hpp"
@@ -71,6 +74,70 @@ double plan_cost(const OptimalPlan& plan, const std::vector<double>& volume) {
     double sum = 0.0;
     for (const OptimalGroup& g : plan.groups) sum += static_cast<double>(g.children.size()) * volume[g.covered];
     return sum;
+}
+
+/// The optimum by a second, slower recursion, for sizes enumeration cannot reach: for a parent of volume w,
+/// cover(T) = min over blocks B holding T's lowest member of (w + best(B)) + cover(T \ B), each block paying
+/// w for its place among the children; best(S) takes the block of S's lowest member as a proper subset, so a
+/// node has two children or more. 4^n work.
+double optimum_by_covers(std::uint32_t n, const std::vector<double>& volume) {
+    std::vector<double> best(1u << n, 0.0);
+    for (std::uint32_t s = 1; s < (1u << n); ++s) {
+        if (std::popcount(s) == 1) continue;
+        const double w = volume[s];
+        std::map<std::uint32_t, double> cover{{0u, 0.0}};
+        const std::function<double(std::uint32_t)> cover_of = [&](std::uint32_t t) {
+            if (auto it = cover.find(t); it != cover.end()) return it->second;
+            const std::uint32_t low = t & (~t + 1u);
+            double least = std::numeric_limits<double>::infinity();
+            for (std::uint32_t sub = t ^ low;; sub = (sub - 1u) & (t ^ low)) {
+                least = std::min(least, w + best[low | sub] + cover_of(t ^ (low | sub)));
+                if (sub == 0) break;
+            }
+            return cover[t] = least;
+        };
+        const std::uint32_t low = s & (~s + 1u);
+        const std::uint32_t rest = s ^ low;
+        double least = std::numeric_limits<double>::infinity();
+        for (std::uint32_t sub = (rest - 1u) & rest;; sub = (sub - 1u) & rest) {
+            least = std::min(least, w + best[low | sub] + cover_of(s ^ (low | sub)));
+            if (sub == 0) break;
+        }
+        best[s] = least;
+    }
+    return best.back();
+}
+
+/// A random volume function with ties, over n members.
+std::vector<double> random_volumes(SplitMix64& rng, std::uint32_t n) {
+    std::vector<double> volume(1u << n, 0.0);
+    for (std::uint32_t s = 1; s < (1u << n); ++s)
+        volume[s] = rng.below(4) == 0 ? static_cast<double>(rng.below(3) + 1)
+                                      : static_cast<double>(std::popcount(s)) * rng.uniform(0.2, 2.0);
+    return volume;
+}
+
+/// fit_best's weighted volume over every subset, as build_optimal fits them (FitInput in input order).
+std::vector<double> every_fit(std::span<const Primitive> primitives, const VolumePolicy& policy) {
+    const auto n = static_cast<std::uint32_t>(primitives.size());
+    std::vector<double> volume(1u << n, 0.0);
+    for (std::uint32_t s = 1; s < (1u << n); ++s) {
+        if (std::popcount(s) < 2) continue;
+        FitInput input;
+        for (std::uint32_t i = 0; i < n; ++i)
+            if (s >> i & 1u) input.add(primitives[i].volume);
+        volume[s] = policy.weighted_volume(fit_best(input.spheres, policy, input.hint_axes));
+    }
+    return volume;
+}
+
+/// How many subsets build_optimal fitted, from its report's note.
+std::uint64_t fitted_subsets(const BuildReport& report) {
+    for (const std::string& note : report.notes)
+        if (const auto at = note.find(" subsets, "); at != std::string::npos)
+            return std::stoull(note.substr(at + 10));
+    ADD_FAILURE() << "no fit count in the report";
+    return 0;
 }
 
 TEST(OptimalHierarchy, EnumeratorCountsSchroderTrees) {
@@ -141,6 +208,87 @@ TEST(OptimalHierarchy, BuildEqualsEnumerationOnSmallScenes) {
             EXPECT_NEAR(report.lower_bound, brute, 1e-9 * brute);
         }
     }
+}
+
+TEST(OptimalHierarchy, ParallelSizesEqualASecondRecursion) {
+    // From 12 members the DP solves the subsets of one size in parallel: the same optimum as a recursion
+    // written another way, on volume functions with ties.
+    SplitMix64 rng(77);
+    for (std::uint32_t n : {8u, 12u, 13u}) {
+        const std::vector<double> volume = random_volumes(rng, n);
+        const OptimalPlan plan = solve_optimal_hierarchy(n, volume);
+        const double expected = optimum_by_covers(n, volume);
+        EXPECT_NEAR(plan.cost, expected, 1e-9 * expected) << "n=" << n;
+        EXPECT_NEAR(plan_cost(plan, volume), plan.cost, 1e-9 * expected);
+    }
+}
+
+TEST(OptimalHierarchy, OutsideCostIsTheCheapestTreeThroughEachSet) {
+    // best(S) + outside(S) against the optimum of the problem with S contracted into one leaf that costs
+    // best(S) (every tree with S as a node is such a tree with S's subtree hung at that leaf).
+    SplitMix64 rng(91);
+    for (std::uint32_t n : {6u, 12u}) {
+        const std::vector<double> volume = random_volumes(rng, n);
+        const detail::SubsetTables tables = detail::solve_subsets(n, volume);
+        const std::vector<double> outside = detail::cost_outside(tables, volume);
+        const std::uint32_t full = (1u << n) - 1u;
+        int checked = 0;
+        for (std::uint32_t s = 3; s < full; s += n < 10 ? 1 : 37) {
+            if (std::popcount(s) < 2) continue;
+            // The contracted items: S's members as item 0, every other member as one item each.
+            std::vector<std::uint32_t> item_bits{s};
+            for (std::uint32_t i = 0; i < n; ++i)
+                if (!(s >> i & 1u)) item_bits.push_back(1u << i);
+            const auto m = static_cast<std::uint32_t>(item_bits.size());
+            std::vector<double> contracted(1u << m, 0.0);
+            for (std::uint32_t c = 1; c < (1u << m); ++c) {
+                std::uint32_t bits = 0;
+                for (std::uint32_t j = 0; j < m; ++j)
+                    if (c >> j & 1u) bits |= item_bits[j];
+                contracted[c] = volume[bits];
+            }
+            const double expected = tables.best[s] + solve_optimal_hierarchy(m, contracted).cost;
+            EXPECT_NEAR(tables.best[s] + outside[s], expected, 1e-9 * expected) << "n=" << n << " S=" << s;
+            ++checked;
+        }
+        EXPECT_GT(checked, 50);
+        EXPECT_EQ(outside[full], 0.0);
+    }
+}
+
+TEST(OptimalHierarchy, FitsOnDemandGiveTheOptimumOverEveryFit) {
+    // The builder fits only the subsets its rounds ask for; its tree must cost what the DP over every subset's
+    // fit gives, under weights and the Minkowski measure too (the bounds scale with both).
+    VolumePolicy weighted = VolumePolicy::all();
+    weighted.weight = {1.0, 1.3, 0.45, 1.8};
+    VolumePolicy minkowski = VolumePolicy::all();
+    minkowski.measure = NodeMeasure::minkowski;
+    const std::vector<VolumePolicy> policies{VolumePolicy::all(), weighted, minkowski,
+                                             VolumePolicy::only(BvType::capsule), VolumePolicy::only(BvType::obb)};
+    std::uint64_t fitted = 0, subsets = 0;
+    for (std::uint32_t n : {9u, 11u}) {
+        const auto primitives = generate_scene({.count = n, .seed = 40u + n});
+        for (const VolumePolicy& policy : policies) {
+            const double expected = solve_optimal_hierarchy(n, every_fit(primitives, policy)).cost;
+            BuildReport report;
+            const Result<Bvh> bvh = build_optimal(primitives, test_support::context_for(policy, &report));
+            ASSERT_TRUE(bvh.has_value());
+            EXPECT_NEAR(tree_cost(*bvh, policy), expected, 1e-12 * expected) << "n=" << n;
+            EXPECT_NEAR(report.lower_bound, expected, 1e-12 * expected);
+            fitted += fitted_subsets(report);
+            subsets += (1u << n) - n - 1;
+        }
+    }
+    // The chair, where the bounds are tight: most subsets are never fitted.
+    const Result<XmlModel> chair = read_xml_file(std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models" / "chair.xml");
+    ASSERT_TRUE(chair.has_value());
+    BuildReport report;
+    const Result<Bvh> bvh = build_optimal(chair->primitives, test_support::context_for(VolumePolicy::all(), &report));
+    ASSERT_TRUE(bvh.has_value());
+    const double expected = solve_optimal_hierarchy(13, every_fit(chair->primitives, VolumePolicy::all())).cost;
+    EXPECT_NEAR(tree_cost(*bvh, VolumePolicy::all()), expected, 1e-12 * expected);
+    EXPECT_LT(fitted_subsets(report), 8178u / 4);
+    EXPECT_LE(fitted, subsets);
 }
 
 TEST(OptimalHierarchy, NoWorseThanAnyRegisteredBuilder) {
