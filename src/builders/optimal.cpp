@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -26,7 +27,7 @@ namespace {
 /// Fits on demand: the first round fits this fraction of all subsets (the unfitted ones through which the
 /// cheapest trees over the current volumes pass), and each further round this factor times as many: a DP round
 /// at 17 primitives costs about what 10 000 fits do, so few large rounds beat many small ones (measured in
-/// docs/solver.md §2). A round that would fit half the unfitted subsets or more fits them all.
+/// docs/solver.md §2). A round that would fit half of the subsets still worth fitting or more fits them all.
 constexpr double first_round_fraction = 0.1;
 constexpr double round_growth = 3.0;
 
@@ -71,27 +72,31 @@ std::vector<double> subset_bounds(std::span<const Primitive> primitives, std::ui
     return bound;
 }
 
-/// The `wanted` unfitted subsets through which the cheapest trees pass under the current volumes (tables.best +
-/// the outside cost; ties by mask), and the plan's unfitted groups; ascending.
+/// The subsets the next round fits: of the unfitted ones through which a tree can cost at most `upper` (the
+/// cheapest fitted tree known; through the others every tree costs more, so they are never needed), the `wanted`
+/// cheapest by the cheapest tree through them under the current volumes (tables.best + the outside cost; ties by
+/// mask), or all of them where that is at least half; and the plan's unfitted groups. Ascending.
 std::vector<std::uint32_t> next_fits(const detail::SubsetTables& tables, std::span<const double> volume,
                                      const std::vector<std::vector<std::uint32_t>>& by_size,
                                      const std::vector<std::optional<BoundingVolume>>& fitted,
-                                     const OptimalPlan& plan, std::size_t wanted) {
+                                     const OptimalPlan& plan, double upper, std::size_t wanted) {
     std::vector<std::pair<double, std::uint32_t>> ranked;
     for (std::size_t size = 2; size < by_size.size(); ++size)
         for (std::uint32_t mask : by_size[size])
             if (!fitted[mask]) ranked.emplace_back(0.0, mask);
-    std::vector<std::uint32_t> out;
-    if (2 * wanted >= ranked.size()) {
-        for (const auto& entry : ranked) out.push_back(entry.second);
-    } else {
+    if (std::isfinite(upper) || 2 * wanted < ranked.size()) {
         const std::vector<double> outside = detail::cost_outside(tables, volume);
         for (auto& [through, mask] : ranked) through = tables.best[mask] + outside[mask];
-        std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(wanted), ranked.end());
-        for (std::size_t j = 0; j < wanted; ++j) out.push_back(ranked[j].second);
-        for (const OptimalGroup& group : plan.groups)  // through them runs the cheapest tree, but ties may hide them
-            if (!fitted[group.covered]) out.push_back(group.covered);
+        std::erase_if(ranked, [&](const auto& entry) { return entry.first > upper; });
+        if (2 * wanted < ranked.size()) {
+            std::nth_element(ranked.begin(), ranked.begin() + static_cast<std::ptrdiff_t>(wanted), ranked.end());
+            ranked.resize(wanted);
+        }
     }
+    std::vector<std::uint32_t> out;
+    for (const auto& entry : ranked) out.push_back(entry.second);
+    for (const OptimalGroup& group : plan.groups)  // the cheapest tree runs through them, but ties may hide them
+        if (!fitted[group.covered]) out.push_back(group.covered);
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
@@ -174,6 +179,7 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         fit_masks(all);
     }
     double wanted = first_round_fraction * static_cast<double>(subsets);
+    double upper = std::numeric_limits<double>::infinity();
     OptimalPlan plan;
     for (;;) {
         checkpoint.step(static_cast<double>(fits));
@@ -183,8 +189,16 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         const bool complete = std::all_of(plan.groups.begin(), plan.groups.end(),
                                           [&](const OptimalGroup& group) { return fitted[group.covered].has_value(); });
         if (complete) break;
-        fit_masks(next_fits(tables, volume, by_size, fitted, plan, static_cast<std::size_t>(wanted)));
+        fit_masks(next_fits(tables, volume, by_size, fitted, plan, upper, static_cast<std::size_t>(wanted)));
         wanted *= round_growth;
+        // The cheapest tree of fitted subsets alone (the plan's tree is one: its groups are fitted now) is a real
+        // tree, so what it costs bounds the optimum, and the next round need not fit a subset through which every
+        // tree costs more. On generated scenes this tree is already the optimum after the first round (the rounds
+        // after it prove it).
+        std::vector<double> fitted_only(volume);
+        for (std::uint32_t mask = 0; mask < subsets; ++mask)
+            if (std::popcount(mask) > 1 && !fitted[mask]) fitted_only[mask] = std::numeric_limits<double>::infinity();
+        upper = std::min(upper, detail::solve_subsets(count, fitted_only).best.back());
     }
 
     checkpoint.step(static_cast<double>(subsets));
