@@ -8,11 +8,61 @@
 #include <numbers>
 #include <optional>
 
+#include "../fit/hull_2d.hpp"
 #include "../fit/quickhull.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
 
 namespace hbvh::detail {
 namespace {
+
+/// The bound of points that span no solid (or fewer than four): every volume around them holds the polygon
+/// Q of their projections on a plane through them, grown by the margin less their largest distance e from
+/// that plane (Q lies within e of their hull), and a polygon of area A and perimeter P grown by m has volume
+/// 2 A m + (pi / 2) P m^2 + 4/3 pi m^3 (Steiner's formula with every edge's exterior angle pi; a segment is
+/// a polygon of area 0 and perimeter twice its length, a capsule). 0 where the points are not that flat.
+double flat_bound(std::span<const Vec3> points, double margin) {
+    if (points.empty()) return 0.0;
+    // The plane: through the first point, the farthest from it, and the farthest from their line (any plane
+    // through that line where all are on it).
+    const Vec3 origin = points.front();
+    Vec3 far = origin;
+    for (const Vec3& p : points)
+        if ((p - origin).squaredNorm() > (far - origin).squaredNorm()) far = p;
+    const double extent = (far - origin).norm();
+    if (!(extent > 0.0)) return 0.0;  // one point: the ball bound says it all
+    const Vec3 along = (far - origin) / extent;
+    Vec3 normal = along.unitOrthogonal();
+    double widest = 0.0;
+    for (const Vec3& p : points) {
+        const Vec3 cross = along.cross(p - origin);
+        if (cross.norm() > widest) {
+            widest = cross.norm();
+            normal = cross / widest;
+        }
+    }
+    const Vec3 across = normal.cross(along);
+    double distance = 0.0;
+    thread_local std::vector<Eigen::Vector2d> projected, polygon;
+    projected.clear();
+    for (const Vec3& p : points) {
+        distance = std::max(distance, std::abs(normal.dot(p - origin)));
+        projected.emplace_back(along.dot(p - origin), across.dot(p - origin));
+    }
+    // Rounding in the projection is a few ulps of the extent; the margin left must cover it too.
+    const double m = margin - distance - 1e-12 * extent;
+    if (!(m > 0.0)) return 0.0;
+    hull_2d(projected, polygon);
+    double twice_area = 0.0;
+    double perimeter = 0.0;
+    for (std::size_t i = 0; i < polygon.size(); ++i) {
+        const Eigen::Vector2d& a = polygon[i];
+        const Eigen::Vector2d& b = polygon[(i + 1) % polygon.size()];
+        twice_area += a.x() * b.y() - a.y() * b.x();
+        perimeter += (b - a).norm();
+    }
+    if (polygon.size() < 3) twice_area = 0.0;  // a segment (there and back) or a point
+    return twice_area * m + std::numbers::pi / 2.0 * perimeter * m * m + 4.0 / 3.0 * std::numbers::pi * m * m * m;
+}
 
 /// The hull of `points` grown by `margin`: its bound and its vertices.
 SetBound grown_hull(std::vector<Vec3> points, double margin, double scale) {
@@ -21,12 +71,13 @@ SetBound grown_hull(std::vector<Vec3> points, double margin, double scale) {
     const double m = margin;
     const double ball = 4.0 / 3.0 * std::numbers::pi * m * m * m;
     out.bound = ball * scale;
-    if (points.size() < 4 || points.size() > quickhull_max_points) {
+    if (points.size() > quickhull_max_points) {
         out.points = std::move(points);
         return out;
     }
-    const std::optional<TriangleHull> hull = quickhull(points);
-    if (!hull) {
+    const std::optional<TriangleHull> hull = points.size() < 4 ? std::nullopt : quickhull(points);
+    if (!hull) {  // flat, or no solid the quickhull builds: the polygon's bound where it is flat
+        out.bound = std::max(out.bound, flat_bound(points, margin) * scale);
         out.points = std::move(points);
         return out;
     }

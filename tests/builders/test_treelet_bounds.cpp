@@ -123,9 +123,48 @@ TEST(TreeletBounds, MatchesSteinersFormulaForBallsAtACubesCorners) {
         EXPECT_NEAR(both, with_chords, 1e-5 * exact) << "r " << r;
         EXPECT_LT(both, exact) << "r " << r;
         EXPECT_NEAR(detail::bound_set(primitives, all, scale).bound, both, 1e-9 * exact) << "r " << r;
-        // Each half is a flat square of balls: no solid hull of centres, so the bound is one ball.
-        EXPECT_NEAR(low_bound.bound, 4.0 / 3.0 * pi * r * r * r, 1e-5 * exact) << "r " << r;
+        // Each half is a flat square of balls: no solid hull of centres, so the bound is the unit square grown
+        // by r, 2 r + 2 pi r^2 + 4/3 pi r^3 (its edges' exterior angles are exactly pi).
+        EXPECT_NEAR(low_bound.bound, 2.0 * r + 2.0 * pi * r * r + 4.0 / 3.0 * pi * r * r * r, 1e-5 * exact) << "r " << r;
     }
+}
+
+TEST(TreeletBounds, FlatSetsGetTheirPolygonsBoundNeverAboveTheFit) {
+    // Capsules and balls of one radius whose axes and centres lie in a plane (a walker's legs, a hand's
+    // fingers) span no solid: the bound is their polygon grown by the radius, not one ball. Exactly flat,
+    // off the plane by 1e-9, by 1e-4 (then the margin left shrinks), and on one line (a capsule).
+    std::mt19937_64 random(5);
+    std::uniform_real_distribution<double> coordinate(-1.0, 1.0);
+    std::vector<double> ratios;
+    for (double wobble : {0.0, 1e-9, 1e-4}) {
+        for (bool line : {false, true}) {
+            const double r = 0.05;
+            std::vector<Primitive> primitives;
+            const auto point = [&] {
+                const double y = line ? 0.0 : coordinate(random);
+                return Vec3(coordinate(random), y, wobble * coordinate(random));
+            };
+            for (int i = 0; i < 6; ++i) {
+                if (i % 3 == 2)
+                    primitives.push_back(Primitive{Sphere{point(), r}, ""});
+                else
+                    primitives.push_back(Primitive{Capsule{point(), point(), r}, ""});
+            }
+            std::vector<std::vector<std::uint32_t>> units;
+            for (std::uint32_t i = 0; i < primitives.size(); ++i) units.push_back({i});
+            for (const VolumePolicy& policy : policies()) {
+                const std::string what = "wobble " + std::to_string(wobble) + (line ? " on a line" : "");
+                const std::vector<double> some = check_masks(primitives, units, policy, what);
+                ratios.insert(ratios.end(), some.begin(), some.end());
+            }
+            // Above the ball the bound was before: a polygon's bound grows with its area and perimeter.
+            const std::vector<std::uint32_t> all{0, 1, 2, 3, 4, 5};
+            const double scale = detail::bound_scale(VolumePolicy::all());
+            EXPECT_GT(detail::bound_set(primitives, all, scale).bound, 10.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * scale);
+        }
+    }
+    std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
+    EXPECT_GT(ratios[ratios.size() / 2], 0.2);
 }
 
 TEST(TreeletBounds, RefiningWithThemGivesTheCostsOfFittingEverySetWithFewerFits) {
