@@ -189,16 +189,19 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         const bool complete = std::all_of(plan.groups.begin(), plan.groups.end(),
                                           [&](const OptimalGroup& group) { return fitted[group.covered].has_value(); });
         if (complete) break;
+        if (fits > 0) {
+            // The cheapest tree of fitted subsets alone (the last plan's tree is one: its groups were fitted) is a
+            // real tree, so what it costs bounds the optimum, and this round need not fit a subset through which
+            // every tree costs more. On generated scenes it is already the optimum after the first round (the
+            // rounds after it prove it). Not made before a second round: where the first round's fits suffice
+            // (the bundled models), it would cost a DP for nothing.
+            std::vector<double> fitted_only(volume);
+            for (std::uint32_t mask = 0; mask < subsets; ++mask)
+                if (std::popcount(mask) > 1 && !fitted[mask]) fitted_only[mask] = std::numeric_limits<double>::infinity();
+            upper = std::min(upper, detail::solve_subsets(count, fitted_only).best.back());
+        }
         fit_masks(next_fits(tables, volume, by_size, fitted, plan, upper, static_cast<std::size_t>(wanted)));
         wanted *= round_growth;
-        // The cheapest tree of fitted subsets alone (the plan's tree is one: its groups are fitted now) is a real
-        // tree, so what it costs bounds the optimum, and the next round need not fit a subset through which every
-        // tree costs more. On generated scenes this tree is already the optimum after the first round (the rounds
-        // after it prove it).
-        std::vector<double> fitted_only(volume);
-        for (std::uint32_t mask = 0; mask < subsets; ++mask)
-            if (std::popcount(mask) > 1 && !fitted[mask]) fitted_only[mask] = std::numeric_limits<double>::infinity();
-        upper = std::min(upper, detail::solve_subsets(count, fitted_only).best.back());
     }
 
     checkpoint.step(static_cast<double>(subsets));
