@@ -10,8 +10,8 @@
 #include <algorithm>
 #include <bit>
 #include <chrono>
-#include <limits>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -127,7 +127,6 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildCont
         return optimal_tree(primitives, context, limit, checkpoint);
     });
 }
-
 
 namespace {
 
