@@ -38,12 +38,21 @@ constexpr std::uint32_t member_count(std::uint32_t mask) {
 }
 static_assert(member_count(0) == 0 && member_count(0xFFFFFFFFu) == 32 && member_count(0x80000101u) == 3);
 
+/// The two hot loops come in an AVX2 clone, picked at load time where the processor has it (the portable build
+/// targets plain x86-64): min and add on four doubles at once instead of two, the same operations on every
+/// element, so the tables are bit for bit the same either way.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define HBVH_WIDE_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define HBVH_WIDE_CLONES
+#endif
+
 /// From this many primitives on, the subsets of one size are solved in parallel (below, a task costs more
 /// than the work: treelets solve DPs of a few units).
 constexpr std::uint32_t parallel_from = 12;
 
 /// best(S), P_k(S) and argmin k for one subset S, from the entries of its proper subsets.
-void solve_subset(detail::SubsetTables& t, std::span<const double> volume, std::uint32_t s) {
+HBVH_WIDE_CLONES void solve_subset(detail::SubsetTables& t, std::span<const double> volume, std::uint32_t s) {
     double* row = t.row(s);
     const std::uint32_t size = member_count(s);
     if (size == 1) {
@@ -88,7 +97,7 @@ constexpr std::array<double, optimal_hard_limit> extra_children = [] {
 /// outside(S), pulled from the larger sets. S's parent Q has S and a partition of R = Q \ S into j blocks as
 /// its j + 1 children, so
 ///     outside(S) = min over R != {} disjoint from S, j = 1..|R| of outside(S | R) + (j+1)·vol(S | R) + P_j(R).
-double outside_of(const detail::SubsetTables& t, std::span<const double> volume, std::span<const double> outside,
+HBVH_WIDE_CLONES double outside_of(const detail::SubsetTables& t, std::span<const double> volume, std::span<const double> outside,
                   std::uint32_t s) {
     const std::uint32_t others = ((1u << t.count) - 1u) ^ s;
     // The least so far per j, in independent lanes the compiler vectorises (one running minimum would chain
