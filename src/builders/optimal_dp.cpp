@@ -18,7 +18,6 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <limits>
 
 #include "hbvh/assert.hpp"
@@ -87,7 +86,7 @@ HBVH_WIDE_CLONES void solve_subset(detail::SubsetTables& t, std::span<const doub
     row[0] = best;
 }
 
-/// 0, 1, 2, ...: the children a parent has beyond two per block of R beyond the first, as doubles.
+/// j as a double, j = 0, 1, 2, ...: a parent with S and j + 1 blocks of R as children has j children more than two.
 constexpr std::array<double, optimal_hard_limit> extra_children = [] {
     std::array<double, optimal_hard_limit> out{};
     for (std::size_t j = 0; j < out.size(); ++j) out[j] = static_cast<double>(j);
@@ -97,8 +96,8 @@ constexpr std::array<double, optimal_hard_limit> extra_children = [] {
 /// outside(S), pulled from the larger sets. S's parent Q has S and a partition of R = Q \ S into j blocks as
 /// its j + 1 children, so
 ///     outside(S) = min over R != {} disjoint from S, j = 1..|R| of outside(S | R) + (j+1)·vol(S | R) + P_j(R).
-HBVH_WIDE_CLONES double outside_of(const detail::SubsetTables& t, std::span<const double> volume, std::span<const double> outside,
-                  std::uint32_t s) {
+HBVH_WIDE_CLONES double outside_of(const detail::SubsetTables& t, std::span<const double> volume,
+                                   std::span<const double> outside, std::uint32_t s) {
     const std::uint32_t others = ((1u << t.count) - 1u) ^ s;
     // The least so far per j, in independent lanes the compiler vectorises (one running minimum would chain
     // every term).
