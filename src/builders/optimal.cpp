@@ -30,6 +30,8 @@ namespace {
 /// docs/solver.md §2). A round that would fit half of the subsets still worth fitting or more fits them all.
 constexpr double first_round_fraction = 0.1;
 constexpr double round_growth = 3.0;
+/// The share of the progress bar the bounds take (it counts subsets: the fits take the rest).
+constexpr double bounds_share = 0.1;
 
 /// The bits of `mask`, ascending: the covered primitives' input indices.
 std::vector<std::uint32_t> members_of(std::uint32_t mask) {
@@ -52,7 +54,8 @@ std::vector<double> subset_bounds(std::span<const Primitive> primitives, std::ui
         made[1u << i] = detail::bound_set(primitives, single, scale);
     }
     for (std::uint32_t size = 2; size <= count; ++size) {
-        checkpoint.step(0.0);
+        // Progress counts subsets: the bounds are the first tenth of it (the fits and the DP rounds the rest).
+        checkpoint.step(bounds_share * subsets * (size - 1) / count);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, by_size[size].size(), 64),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t j = range.begin(); j != range.end(); ++j) {
@@ -149,12 +152,19 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
     std::vector<double> volume(subsets, 0.0);
     std::vector<std::optional<BoundingVolume>> fitted(subsets);
     std::uint64_t fits = 0, solves = 0;
+    // Where boxes or capsules are allowed a fit costs far more than a bound: subsets are fitted on demand.
+    const bool on_demand = policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule);
+    const auto fitting_progress = [&](std::uint64_t fitted_so_far) {  // in subsets, after the bounds' share
+        const double share = on_demand ? bounds_share : 0.0;
+        return subsets * (share + (1.0 - share) * static_cast<double>(fitted_so_far) / subsets);
+    };
     // fit_best over the primitives of each of `masks`, with FitInput over them in input order (as two-level
     // does), in parallel: each entry depends on its subset only, so nothing depends on the thread count.
     const auto fit_masks = [&](std::span<const std::uint32_t> masks) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 16),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-                              checkpoint.step(static_cast<double>(fits + range.begin()));  // approximate progress
+                              // approximate: blocks finish in any order
+                              checkpoint.step(fitting_progress(fits + range.begin()));
                               for (std::size_t j = range.begin(); j != range.end(); ++j) {
                                   FitInput input;
                                   for (std::uint32_t i : members_of(masks[j])) input.add(primitives[i].volume);
@@ -165,12 +175,12 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         fits += masks.size();
     };
 
-    // The subset volumes. Where boxes or capsules are allowed a fit costs far more than a bound, and subsets are
-    // fitted on demand: every subset stands in by a lower bound of its weighted volume until it is fitted, and
-    // each round fits the unfitted subsets the cheapest trees pass through, until the DP's optimum uses fitted
-    // subsets only. That optimum is the optimum over all fits (every other tree costs at least its bounds), so
-    // the tree is the one of fitting every subset, up to a choice between trees of exactly equal cost.
-    if (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule)) {
+    // The subset volumes. Fitted on demand, every subset stands in by a lower bound of its weighted volume until
+    // it is fitted, and each round fits the unfitted subsets the cheapest trees pass through, until the DP's
+    // optimum uses fitted subsets only. That optimum is the optimum over all fits (every other tree costs at
+    // least its bounds), so the tree is the one of fitting every subset, up to a choice between trees of exactly
+    // equal cost.
+    if (on_demand) {
         volume = subset_bounds(primitives, count, detail::bound_scale(policy), by_size, checkpoint);
     } else {
         std::vector<std::uint32_t> all;
@@ -181,7 +191,7 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
     double upper = std::numeric_limits<double>::infinity();
     OptimalPlan plan;
     for (;;) {
-        checkpoint.step(static_cast<double>(fits));
+        checkpoint.step(fitting_progress(fits));
         const detail::SubsetTables tables = detail::solve_subsets(count, volume);
         ++solves;
         plan = detail::plan_of(tables);
