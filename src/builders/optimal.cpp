@@ -184,7 +184,8 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
         volume = subset_bounds(primitives, count, detail::bound_scale(policy), by_size, checkpoint);
     } else {
         std::vector<std::uint32_t> all;
-        for (std::uint32_t size = 2; size <= count; ++size) all.insert(all.end(), by_size[size].begin(), by_size[size].end());
+        for (std::uint32_t size = 2; size <= count; ++size)
+            all.insert(all.end(), by_size[size].begin(), by_size[size].end());
         fit_masks(all);
     }
     double wanted = first_round_fraction * static_cast<double>(subsets);
@@ -206,7 +207,8 @@ Result<Bvh> optimal_tree(std::span<const Primitive> primitives, const BuildConte
             // (the bundled models), it would cost a DP for nothing.
             std::vector<double> fitted_only(volume);
             for (std::uint32_t mask = 0; mask < subsets; ++mask)
-                if (std::popcount(mask) > 1 && !fitted[mask]) fitted_only[mask] = std::numeric_limits<double>::infinity();
+                if (std::popcount(mask) > 1 && !fitted[mask])
+                    fitted_only[mask] = std::numeric_limits<double>::infinity();
             upper = std::min(upper, detail::solve_subsets(count, fitted_only).best.back());
         }
         fit_masks(next_fits(tables, volume, by_size, fitted, plan, upper, static_cast<std::size_t>(wanted)));

@@ -280,7 +280,8 @@ TEST(OptimalHierarchy, FitsOnDemandGiveTheOptimumOverEveryFit) {
         }
     }
     // The chair, where the bounds are tight: most subsets are never fitted.
-    const Result<XmlModel> chair = read_xml_file(std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models" / "chair.xml");
+    const Result<XmlModel> chair =
+        read_xml_file(std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models" / "chair.xml");
     ASSERT_TRUE(chair.has_value());
     BuildReport report;
     const Result<Bvh> bvh = build_optimal(chair->primitives, test_support::context_for(VolumePolicy::all(), &report));

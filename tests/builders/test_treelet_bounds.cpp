@@ -160,7 +160,8 @@ TEST(TreeletBounds, FlatSetsGetTheirPolygonsBoundNeverAboveTheFit) {
             // Above the ball the bound was before: a polygon's bound grows with its area and perimeter.
             const std::vector<std::uint32_t> all{0, 1, 2, 3, 4, 5};
             const double scale = detail::bound_scale(VolumePolicy::all());
-            EXPECT_GT(detail::bound_set(primitives, all, scale).bound, 10.0 * 4.0 / 3.0 * std::numbers::pi * r * r * r * scale);
+            const double ball = 4.0 / 3.0 * std::numbers::pi * r * r * r * scale;
+            EXPECT_GT(detail::bound_set(primitives, all, scale).bound, 10.0 * ball);
         }
     }
     std::nth_element(ratios.begin(), ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2), ratios.end());
