@@ -189,13 +189,7 @@ TEST(OptimalHierarchy, BuildEqualsEnumerationOnSmallScenes) {
         for (std::uint64_t seed = 1; seed <= 3; ++seed) {
             const auto primitives = generate_scene({.count = n, .seed = seed * 31 + n});
             const VolumePolicy policy = seed == 2 ? VolumePolicy::only(BvType::aabb) : VolumePolicy::all();
-            std::vector<double> volume(1u << n, 0.0);
-            for (std::uint32_t s = 1; s < (1u << n); ++s) {
-                FitInput input;
-                for (std::uint32_t i = 0; i < n; ++i)
-                    if (s >> i & 1u) input.add(primitives[i].volume);
-                volume[s] = policy.weighted_volume(fit_best(input.spheres, policy, input.hint_axes));
-            }
+            const std::vector<double> volume = every_fit(primitives, policy);
             std::map<std::uint32_t, std::vector<double>> memo;
             const auto& costs = all_tree_costs((1u << n) - 1u, volume, memo);
             const double brute = *std::min_element(costs.begin(), costs.end());
