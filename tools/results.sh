@@ -537,14 +537,15 @@ if wanted 7; then
          "objective over \`auto\` built for Eq. 2. The survey's searches (\`bnb-*\`, \`optimal\`) run up to 100" \
          "primitives and 5 s per build." ""
     emit "The calibrated objective's per-kind weights are measured first, on this machine, by \`hbvh calibrate\`" \
-         "(each kind's inner-node test cost in the tandem traversal, relative to an AABB's):" ""
+         "(the tandem traversal's inner-node test cost for each pair of kinds; a kind's weight is its test against" \
+         "its own kind, relative to an AABB's against an AABB; docs/metrics.md \"Per-kind weights\"):" ""
     emit '```' "$hbvh calibrate -o weights.txt" \
-        "build/bench/hbvh_objectives --markdown --summary --collisions 300 --build-seconds 5 --type-weight \"\$(cat weights.txt)\"" \
+        "build/bench/hbvh_objectives --markdown --summary --collisions 300 --build-seconds 5 --type-weight @weights.txt" \
         '```' ''
     "$hbvh" calibrate -o "$work/weights.txt" >"$work/calibrate.txt"
     emit '```' "$(grep -v '^weights written' "$work/calibrate.txt")" '```' ''
     "$build/bench/hbvh_objectives" --markdown --summary --collisions 300 --build-seconds 5 \
-        --type-weight "$(cat "$work/weights.txt")" >"$work/objectives.md" 2>"$work/objectives.err" ||
+        --type-weight "@$work/weights.txt" >"$work/objectives.md" 2>"$work/objectives.err" ||
         emit "_hbvh_objectives exited non-zero: $(tail -1 "$work/objectives.err")_"
     cat "$work/objectives.md" >>"$doc"
     emit "" "**What it shows.**"

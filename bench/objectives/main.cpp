@@ -296,12 +296,14 @@ int main(int argc, char** argv) {
             options.only = argv[++i];
         } else {
             fmt::print(stderr, "usage: hbvh_objectives [--markdown] [--collisions N] [--passes N] [--build-seconds S] "
-                               "[--only NAME] [--verbose] [--all-pairs] [--summary] [--type-weight LIST] [--leaf-weight W]\n");
+                               "[--only NAME] [--verbose] [--all-pairs] [--summary] [--type-weight LIST|@FILE] [--leaf-weight W]\n");
             return 2;
         }
     }
     hbvh::Result<hbvh::VolumePolicy> calibrated =
-        options.type_weights.empty() ? hbvh::VolumePolicy::all() : hbvh::parse_type_weights(options.type_weights);
+        options.type_weights.empty()        ? hbvh::VolumePolicy::all()
+        : options.type_weights.starts_with('@') ? hbvh::read_type_weights_file(options.type_weights.substr(1))
+                                                : hbvh::parse_type_weights(options.type_weights);
     if (!calibrated) {
         fmt::print(stderr, "hbvh_objectives: --type-weight: {}\n", calibrated.error().to_string());
         return 2;

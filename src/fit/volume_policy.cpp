@@ -1,9 +1,13 @@
 // SPDX-License-Identifier: MIT
 #include "hbvh/fit/volume_policy.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
+#include <sstream>
 #include <string>
+
+#include "hbvh/files.hpp"
 
 namespace hbvh {
 namespace {
@@ -56,6 +60,33 @@ Result<VolumePolicy> parse_type_weights(std::string_view list, VolumePolicy base
             return Error{"type weight '" + std::string(entry) + "' needs a positive finite number"};
         base.weight[static_cast<std::size_t>(*type)] = weight;
     }
+    return base;
+}
+
+Result<VolumePolicy> read_type_weights_file(const std::filesystem::path& path, VolumePolicy base) {
+    Result<std::string> text = read_text_file(path);
+    if (!text) return text.error();
+    // A byte order mark, entries on lines or separated by commas or blanks, as an editor may leave them, and
+    // comments from a '#' to the end of its line.
+    std::string_view content = *text;
+    if (content.starts_with("\xEF\xBB\xBF")) content.remove_prefix(3);
+    std::istringstream lines{std::string(content)};
+    int line_number = 0;
+    bool any = false;
+    for (std::string line; std::getline(lines, line);) {
+        ++line_number;
+        line.erase(std::min(line.find('#'), line.size()));
+        std::replace(line.begin(), line.end(), ',', ' ');
+        std::istringstream words(line);
+        std::string list;
+        for (std::string word; words >> word;) list += (list.empty() ? "" : ",") + word;
+        if (list.empty()) continue;
+        Result<VolumePolicy> read = parse_type_weights(list, base);
+        if (!read) return Error{read.error().message, path.string(), line_number};
+        base = read.value();
+        any = true;
+    }
+    if (!any) return Error{"no type=weight entries (the file hbvh calibrate -o writes has one line of them)", path.string()};
     return base;
 }
 

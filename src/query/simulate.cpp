@@ -41,19 +41,19 @@ struct Accumulator {
 };
 
 /// One query of the simulator's method and mode.
-void run_query(const QueryTree& tree, const RigidTransform& pose_a, const RigidTransform& pose_b,
+void run_query(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
                const SimulateOptions& options, CollideResult& result) {
     if (options.method == QueryMethod::tandem)
-        collide(tree, pose_a, tree, pose_b, options.mode, result);
+        collide(a, pose_a, b, pose_b, options.mode, result);
     else
-        collide_two_level(tree, pose_a, tree, pose_b, options.mode, result);
+        collide_two_level(a, pose_a, b, pose_b, options.mode, result);
 }
 
 /// One timed query; only the query call is inside the clock.
 double timed_query(const QueryTree& tree, const RigidTransform& pose_a, const RigidTransform& pose_b,
                    const SimulateOptions& options, CollideResult& result) {
     const auto start = std::chrono::steady_clock::now();
-    run_query(tree, pose_a, pose_b, options, result);
+    run_query(tree, pose_a, tree, pose_b, options, result);
     const auto stop = std::chrono::steady_clock::now();
     return std::chrono::duration<double>(stop - start).count();
 }
@@ -144,6 +144,11 @@ SimulationResult simulate(const Bvh& object, const SimulateOptions& options) {
 
 double time_queries(const QueryTree& tree, std::span<const RigidTransform> poses, SimulatedPhase phase,
                     QueryMethod method, CollideMode mode, int passes) {
+    return time_queries(tree, tree, poses, phase, method, mode, passes);
+}
+
+double time_queries(const QueryTree& a, const QueryTree& b, std::span<const RigidTransform> poses,
+                    SimulatedPhase phase, QueryMethod method, CollideMode mode, int passes) {
     HBVH_ASSERT(!poses.empty() && passes >= 1);
     const SimulateOptions options{.method = method, .mode = mode};
     const RigidTransform identity = RigidTransform::identity();
@@ -153,7 +158,7 @@ double time_queries(const QueryTree& tree, std::span<const RigidTransform> poses
         const auto start = std::chrono::steady_clock::now();
         for (const RigidTransform& pose : poses) {
             const RigidTransform& pose_a = phase == SimulatedPhase::moving ? identity : pose;
-            run_query(tree, pose_a, pose, options, result);
+            run_query(a, pose_a, b, pose, options, result);
         }
         const auto stop = std::chrono::steady_clock::now();
         fastest = std::min(fastest, std::chrono::duration<double>(stop - start).count());

@@ -181,7 +181,7 @@ file(WRITE ${HBVH_CLI_OUT}/edited_weights.txt "${byte_order_mark}aabb=1\n\nobb=1
 hbvh_cli_test(type_weight_file_edited 0 "" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a split
               --type-weight @${HBVH_CLI_OUT}/edited_weights.txt -o ${HBVH_CLI_OUT}/edited_weights_chair.xml)
 file(WRITE ${HBVH_CLI_OUT}/bad_weights.txt "aabb=1\nobb=heavy\n")
-hbvh_cli_test(type_weight_file_bad 2 "bad_weights.txt: type weight 'obb=heavy' needs a positive finite number"
+hbvh_cli_test(type_weight_file_bad 2 "bad_weights.txt:2: type weight 'obb=heavy' needs a positive finite number"
               build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --type-weight @${HBVH_CLI_OUT}/bad_weights.txt
               -o ${HBVH_CLI_OUT}/bad_weights_chair.xml)
 

@@ -2,8 +2,14 @@
 // TreeAssembler layout, level views, validate() and the survey's cost on hand-computed examples.
 #include <gtest/gtest.h>
 
-#include <numbers>
+#include <unistd.h>
 
+#include <filesystem>
+#include <numbers>
+#include <string>
+
+#include "hbvh/files.hpp"
+#include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/tree/bvh.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
@@ -191,6 +197,37 @@ TEST(VolumePolicy, ParsesTypesAndWeights) {
     EXPECT_FALSE(parse_type_weights("obb=0").has_value());
     EXPECT_FALSE(parse_type_weights("obb=nan").has_value());
     EXPECT_FALSE(parse_type_weights("obb").has_value());
+}
+
+// The file `hbvh calibrate -o` writes: its table of pairs as '#' comments, then the weights; entries may also come
+// one per line or separated by ", " as an editor leaves them. A bad entry is named with its file and line.
+TEST(VolumePolicy, ReadsTheCalibratedWeightsFileAndNamesTheLineOfABadEntry) {
+    const std::filesystem::path path =
+        std::filesystem::temp_directory_path() / ("hbvh_weights_" + std::to_string(::getpid()) + ".txt");
+    const auto read = [&](const std::string& text) {
+        EXPECT_TRUE(write_file_atomic(path, text).has_value());
+        return read_type_weights_file(path);
+    };
+    const Result<VolumePolicy> calibrated = read(
+        "# hbvh calibrate: ns per inner-node test\n#          aabb   obb=9\n# aabb    19.5  24.0\n"
+        "aabb=1.000,obb=1.275,sphere=0.384,capsule=1.258\n");
+    ASSERT_TRUE(calibrated.has_value()) << calibrated.error().to_string();
+    EXPECT_DOUBLE_EQ(calibrated->weight_of(BvType::obb), 1.275);  // not the 9 in the comment
+    EXPECT_DOUBLE_EQ(calibrated->weight_of(BvType::sphere), 0.384);
+    const Result<VolumePolicy> edited = read("obb=1.5, capsule=1.2   # heavier\n\nsphere=0.5\n");
+    ASSERT_TRUE(edited.has_value()) << edited.error().to_string();
+    EXPECT_DOUBLE_EQ(edited->weight_of(BvType::capsule), 1.2);
+    EXPECT_DOUBLE_EQ(edited->weight_of(BvType::sphere), 0.5);
+    EXPECT_DOUBLE_EQ(edited->weight_of(BvType::aabb), 1.0);
+    const Result<VolumePolicy> bad = read("# weights\naabb=1\nobb=heavy\n");
+    ASSERT_FALSE(bad.has_value());
+    EXPECT_EQ(bad.error().line, 3);
+    EXPECT_EQ(bad.error().file, path.string());
+    EXPECT_NE(bad.error().message.find("obb=heavy"), std::string::npos);
+    const Result<VolumePolicy> comments_only = read("# nothing measured\n");
+    EXPECT_FALSE(comments_only.has_value());
+    std::filesystem::remove(path);
+    EXPECT_FALSE(read_type_weights_file(path).has_value());  // and a missing file is an error, not the defaults
 }
 
 }  // namespace

@@ -1,11 +1,16 @@
 // SPDX-License-Identifier: MIT
-// `hbvh calibrate`: what an inner node's overlap test costs in the tandem traversal, per BV kind, on this
-// machine, written as per-kind weights that `--type-weight @FILE` reads (docs/metrics.md, "Calibrated cost").
+// `hbvh calibrate`: what an inner node's overlap test costs in the tandem traversal, per pair of BV kinds, on
+// this machine, written as per-kind weights that `--type-weight @FILE` reads (docs/metrics.md, "Calibrated cost").
 //
-// One generated scene is built four times, each time with a single kind allowed for the inner nodes, and
-// every tree answers the same recorded simulator queries. A query's time is taken as
-//   T = t_kind x (inner-node tests) + t_leaf x (primitive tests),
-// with t_leaf from the Two-Level query (primitive tests only) on the same queries; each kind's t_kind follows.
+// One generated scene is built four times, each time with a single kind allowed for the inner nodes, and every
+// pair of those trees (one as copy A, the other as copy B) answers the same recorded simulator queries. A query's
+// time is taken as
+//   T = t_pair x (inner-node tests) + t_leaf x (primitive tests),
+// with t_leaf from the Two-Level query (primitive tests only) on the same queries; each pair's t_pair follows.
+// A kind's weight is its test against its own kind, relative to the AABB's: a builder's tree meets copies of
+// itself (the survey's simulator, the benchmarks) or trees built under the same policy. Weighting every partner
+// kind alike instead (the row's mean) ranked the trees of generated objects worse and made their calibrated
+// trees slower (docs/metrics.md, "Per-kind weights"), so the table of pairs is written for the record only.
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -28,24 +33,43 @@ struct CalibrateArguments {
     std::string output;  // empty: print only
 };
 
-/// Tests made over `poses` (copy A at the identity, B at each pose), all pairs reported.
-std::pair<double, double> test_counts(const QueryTree& tree, std::span<const RigidTransform> poses, QueryMethod method) {
+/// Tests made over `poses` (a at the identity, b at each pose), all pairs reported.
+std::pair<double, double> test_counts(const QueryTree& a, const QueryTree& b, std::span<const RigidTransform> poses,
+                                      QueryMethod method) {
     double inner = 0.0, leaf = 0.0;
     CollideResult result;
     for (const RigidTransform& pose : poses) {
         if (method == QueryMethod::tandem)
-            collide(tree, RigidTransform::identity(), tree, pose, CollideMode::all, result);
+            collide(a, RigidTransform::identity(), b, pose, CollideMode::all, result);
         else
-            collide_two_level(tree, RigidTransform::identity(), tree, pose, CollideMode::all, result);
+            collide_two_level(a, RigidTransform::identity(), b, pose, CollideMode::all, result);
         inner += static_cast<double>(result.bv_tests);
         leaf += static_cast<double>(result.primitive_tests);
     }
     return {inner, leaf};
 }
 
-double seconds_for(const QueryTree& tree, std::span<const RigidTransform> poses, QueryMethod method, int passes) {
-    return time_queries(tree, poses, SimulatedPhase::moving, method, CollideMode::all, passes) *
+double seconds_for(const QueryTree& a, const QueryTree& b, std::span<const RigidTransform> poses, QueryMethod method,
+                   int passes) {
+    return time_queries(a, b, poses, SimulatedPhase::moving, method, CollideMode::all, passes) *
            static_cast<double>(poses.size());
+}
+
+/// The weights file: the pair table as comment lines (for the reader), then the weights in --type-weight syntax.
+std::string weights_file(const std::array<std::array<double, bv_type_count>, bv_type_count>& pair_ns,
+                         const std::string& weights) {
+    std::string text = "# hbvh calibrate: ns per inner-node test in the tandem traversal; row: this tree's kind,\n"
+                       "# column: the other tree's. A kind's weight is its diagonal entry over the AABB's.\n";
+    text += fmt::format("# {:<8}", "");
+    for (BvType other : all_bv_types) text += fmt::format(" {:>8}", to_string(other));
+    text += "\n";
+    for (BvType type : all_bv_types) {
+        text += fmt::format("# {:<8}", to_string(type));
+        for (BvType other : all_bv_types)
+            text += fmt::format(" {:>8.2f}", pair_ns[static_cast<std::size_t>(type)][static_cast<std::size_t>(other)]);
+        text += "\n";
+    }
+    return text + weights + "\n";
 }
 
 int run_calibrate(const CalibrateArguments& args) {
@@ -58,36 +82,49 @@ int run_calibrate(const CalibrateArguments& args) {
     if (poses.empty()) return report_error(Error{"the simulator found no root-overlapping queries to time"});
 
     const QueryTree flat_tree(*flat);
-    const double leaf_seconds = seconds_for(flat_tree, poses, QueryMethod::two_level, args.passes) /
-                                test_counts(flat_tree, poses, QueryMethod::two_level).second;
+    const double leaf_seconds = seconds_for(flat_tree, flat_tree, poses, QueryMethod::two_level, args.passes) /
+                                test_counts(flat_tree, flat_tree, poses, QueryMethod::two_level).second;
 
-    std::array<double, bv_type_count> inner_seconds{};
+    std::vector<QueryTree> trees;  // one per kind, in all_bv_types order
     for (BvType type : all_bv_types) {
         BuildContext context;
         context.policy = VolumePolicy::only(type);
         const Result<Bvh> tree = build(scene, Algorithm::split, context);
         if (!tree) return report_error(tree.error());
-        const QueryTree query_tree(*tree);
-        const auto [inner, leaf] = test_counts(query_tree, poses, QueryMethod::tandem);
-        const double total = seconds_for(query_tree, poses, QueryMethod::tandem, args.passes);
-        inner_seconds[static_cast<std::size_t>(type)] = std::max(total - leaf_seconds * leaf, 0.0) / std::max(inner, 1.0);
+        trees.emplace_back(*tree);
     }
+    std::array<std::array<double, bv_type_count>, bv_type_count> pair_ns{};  // [this kind][the other's]
+    for (std::size_t i = 0; i < bv_type_count; ++i)
+        for (std::size_t j = 0; j < bv_type_count; ++j) {
+            const auto [inner, leaf] = test_counts(trees[i], trees[j], poses, QueryMethod::tandem);
+            const double total = seconds_for(trees[i], trees[j], poses, QueryMethod::tandem, args.passes);
+            pair_ns[i][j] = 1e9 * std::max(total - leaf_seconds * leaf, 0.0) / std::max(inner, 1.0);
+        }
 
-    const double aabb = inner_seconds[static_cast<std::size_t>(BvType::aabb)];
-    std::string weights;
-    fmt::print("{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
+    const auto self_ns = [&](BvType type) { return pair_ns[static_cast<std::size_t>(type)][static_cast<std::size_t>(type)]; };
+    const double aabb = self_ns(BvType::aabb);
+    fmt::print("ns per inner-node test (row: this tree's kind, column: the other tree's)\n{:<8}", "");
+    for (BvType other : all_bv_types) fmt::print(" {:>8}", to_string(other));
+    fmt::print("\n");
     for (BvType type : all_bv_types) {
-        const double ns = 1e9 * inner_seconds[static_cast<std::size_t>(type)];
+        fmt::print("{:<8}", to_string(type));
+        for (double ns : pair_ns[static_cast<std::size_t>(type)]) fmt::print(" {:>8.2f}", ns);
+        fmt::print("\n");
+    }
+    std::string weights;
+    fmt::print("\n{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
+    for (BvType type : all_bv_types) {
+        const double ns = self_ns(type);  // against its own kind
         // A kind whose share could not be told from the noise (0 after the leaf tests) keeps weight 1; the floor
         // keeps every weight one that --type-weight accepts (positive at the printed precision).
-        const double weight =
-            aabb > 0.0 && ns > 0.0 ? std::max(inner_seconds[static_cast<std::size_t>(type)] / aabb, 0.001) : 1.0;
+        const double weight = aabb > 0.0 && ns > 0.0 ? std::max(ns / aabb, 0.001) : 1.0;
         fmt::print("{:<8} {:>12.2f} {:>8.3f}\n", to_string(type), ns, weight);
         weights += fmt::format("{}{}={:.3f}", weights.empty() ? "" : ",", to_string(type), weight);
     }
     fmt::print("{:<8} {:>12.2f}   (primitive test, for reference)\n", "leaf", 1e9 * leaf_seconds);
     if (!args.output.empty()) {
-        if (Status written = write_output(args.output, weights + "\n"); !written) return report_error(written.error());
+        if (Status written = write_output(args.output, weights_file(pair_ns, weights)); !written)
+            return report_error(written.error());
         if (args.output != "-") fmt::print("weights written to {} (use: --type-weight @{})\n", args.output, args.output);
     }
     return exit_ok;
@@ -98,7 +135,7 @@ int run_calibrate(const CalibrateArguments& args) {
 void add_calibrate_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<CalibrateArguments>();
     CLI::App* sub = app.add_subcommand(
-        "calibrate", "Measure the tandem traversal's inner-node test cost per BV kind; write per-kind weights");
+        "calibrate", "Measure the tandem traversal's inner-node test cost per pair of BV kinds; write per-kind weights");
     sub->add_option("--primitives", args->primitives, "Primitives in the generated scene")
         ->capture_default_str()
         ->check(CLI::Range(20u, 100000u));

@@ -128,23 +128,14 @@ Result<BuildRequest> BuilderFlags::resolve() const {
     Result<VolumePolicy> policy = parse_allowed_types(types);
     if (!policy) return policy.error();
     if (!type_weights.empty()) {
-        // "@FILE": the weights `hbvh calibrate -o FILE` wrote, in the same type=weight syntax.
-        std::string list = type_weights;
-        std::string source;  // the file the weights came from, for errors
-        if (list.starts_with('@')) {
-            source = list.substr(1);
-            if (source.empty()) return Error{"--type-weight @ needs a file name after the @"};
-            Result<std::string> text = read_text_file(source);
-            if (!text) return text.error();
-            list = *text;
-            // A byte order mark, and entries on lines or separated by blanks, as an editor may leave them.
-            if (list.starts_with("\xEF\xBB\xBF")) list.erase(0, 3);
-            std::istringstream words(list);
-            list.clear();
-            for (std::string word; words >> word;) list += (list.empty() ? "" : ",") + word;
+        // "@FILE": the weights `hbvh calibrate -o FILE` wrote.
+        if (type_weights.starts_with('@')) {
+            if (type_weights.size() == 1) return Error{"--type-weight @ needs a file name after the @"};
+            policy = read_type_weights_file(type_weights.substr(1), policy.value());
+        } else {
+            policy = parse_type_weights(type_weights, policy.value());
         }
-        policy = parse_type_weights(list, policy.value());
-        if (!policy) return source.empty() ? policy.error() : Error{policy.error().message, source};
+        if (!policy) return policy.error();
     }
     if (objective == "calibrated") policy->measure = NodeMeasure::minkowski;
     BuildRequest request;

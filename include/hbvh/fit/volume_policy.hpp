@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <filesystem>
 #include <string_view>
 
 #include "hbvh/geometry/bounding_volume.hpp"
@@ -46,5 +47,8 @@ struct VolumePolicy {
 [[nodiscard]] Result<VolumePolicy> parse_allowed_types(std::string_view list, VolumePolicy base = {});
 /// Parses "obb=1.5,capsule=1.2" into weights (positive, finite). Error names the bad entry.
 [[nodiscard]] Result<VolumePolicy> parse_type_weights(std::string_view list, VolumePolicy base = {});
+/// Reads the weights `hbvh calibrate -o FILE` writes: parse_type_weights' entries, separated by commas, blanks
+/// or lines, after '#' comments (its table of pairs) are dropped, a byte order mark allowed. Errors name the file.
+[[nodiscard]] Result<VolumePolicy> read_type_weights_file(const std::filesystem::path& path, VolumePolicy base = {});
 
 }  // namespace hbvh

@@ -76,5 +76,9 @@ enum class SimulatedPhase : std::uint8_t {
 /// the fastest pass drops what other processes cost. Precondition: poses non-empty, passes >= 1.
 [[nodiscard]] double time_queries(const QueryTree& tree, std::span<const RigidTransform> poses, SimulatedPhase phase,
                                   QueryMethod method, CollideMode mode, int passes);
+/// The same with two different trees over the same poses: `a` as copy A, `b` as copy B (each tree's primitives
+/// in its own frame; `hbvh calibrate` times trees of different BV kinds against each other this way).
+[[nodiscard]] double time_queries(const QueryTree& a, const QueryTree& b, std::span<const RigidTransform> poses,
+                                  SimulatedPhase phase, QueryMethod method, CollideMode mode, int passes);
 
 }  // namespace hbvh
