@@ -270,7 +270,8 @@ void print_summary(const std::vector<std::pair<std::string, Correlations>>& summ
     if (options.markdown) {
         fmt::print("\n| object | trees | ρ Eq. 2 / moving | ρ Eq. 2 / total | ρ calibrated / moving | "
                    "ρ calibrated / total | ρ child-priced / moving | ρ child-priced / total | ρ retest / moving | "
-                   "ρ BV tests / moving | ρ fitted counts / moving | auto/cal ÷ auto, moving | auto/cal ÷ auto, total |\n"
+                   "ρ BV tests / moving | ρ fitted counts / moving | auto/cal ÷ auto, moving | "
+                   "auto/cal ÷ auto, total |\n"
                    "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
         for (const auto& [name, c] : summary)
             fmt::print("| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", name, c.trees,
@@ -322,7 +323,8 @@ int main(int argc, char** argv) {
             options.only = argv[++i];
         } else {
             fmt::print(stderr, "usage: hbvh_objectives [--markdown] [--collisions N] [--passes N] [--build-seconds S] "
-                               "[--only NAME] [--verbose] [--all-pairs] [--summary] [--type-weight LIST|@FILE] [--leaf-weight W]\n");
+                               "[--only NAME] [--verbose] [--all-pairs] [--summary] [--type-weight LIST|@FILE] "
+                               "[--leaf-weight W]\n");
             return 2;
         }
     }

@@ -86,7 +86,8 @@ Result<VolumePolicy> read_type_weights_file(const std::filesystem::path& path, V
         base = read.value();
         any = true;
     }
-    if (!any) return Error{"no type=weight entries (the file hbvh calibrate -o writes has one line of them)", path.string()};
+    if (!any)
+        return Error{"no type=weight entries (the file hbvh calibrate -o writes has one line of them)", path.string()};
     return base;
 }
 

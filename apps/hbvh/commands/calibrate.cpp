@@ -101,7 +101,10 @@ int run_calibrate(const CalibrateArguments& args) {
             pair_ns[i][j] = 1e9 * std::max(total - leaf_seconds * leaf, 0.0) / std::max(inner, 1.0);
         }
 
-    const auto self_ns = [&](BvType type) { return pair_ns[static_cast<std::size_t>(type)][static_cast<std::size_t>(type)]; };
+    const auto self_ns = [&](BvType type) {
+        const auto index = static_cast<std::size_t>(type);
+        return pair_ns[index][index];
+    };
     const double aabb = self_ns(BvType::aabb);
     fmt::print("ns per inner-node test (row: this tree's kind, column: the other tree's)\n{:<8}", "");
     for (BvType other : all_bv_types) fmt::print(" {:>8}", to_string(other));
@@ -135,7 +138,8 @@ int run_calibrate(const CalibrateArguments& args) {
 void add_calibrate_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<CalibrateArguments>();
     CLI::App* sub = app.add_subcommand(
-        "calibrate", "Measure the tandem traversal's inner-node test cost per pair of BV kinds; write per-kind weights");
+        "calibrate",
+        "Measure the tandem traversal's inner-node test cost per pair of BV kinds; write per-kind weights");
     sub->add_option("--primitives", args->primitives, "Primitives in the generated scene")
         ->capture_default_str()
         ->check(CLI::Range(20u, 100000u));

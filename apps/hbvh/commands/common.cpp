@@ -10,7 +10,6 @@
 #include <filesystem>
 #include <iostream>
 #include <iterator>
-#include <sstream>
 #include <system_error>
 
 #include "commands/command.hpp"
