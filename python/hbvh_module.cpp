@@ -326,12 +326,35 @@ void save(const Hierarchy& h, const std::string& path) {
 
 // Stage 4: building, measuring, querying.
 
+/// The CLI's --type-weight: "obb=1.3,capsule=1.2", "@FILE" (the weights `hbvh calibrate -o FILE` wrote), or a
+/// dict {"obb": 1.3}; None leaves every weight 1.
+Result<VolumePolicy> with_type_weights(const py::object& weights, VolumePolicy policy) {
+    if (weights.is_none()) return policy;
+    if (py::isinstance<py::dict>(weights)) {
+        std::string list;
+        for (const auto& [kind, weight] : weights.cast<py::dict>())
+            list += (list.empty() ? "" : ",") + py::str(kind).cast<std::string>() + "=" +
+                    py::repr(py::float_(py::reinterpret_borrow<py::object>(weight))).cast<std::string>();
+        return parse_type_weights(list, policy);
+    }
+    if (!py::isinstance<py::str>(weights))
+        throw py::value_error("type_weights must be a str ('obb=1.3,...' or '@FILE') or a dict, or None");
+    const std::string text = weights.cast<std::string>();
+    if (text.starts_with('@')) {
+        if (text.size() == 1) return Error{"type_weights '@' needs a file name after the @"};
+        return read_type_weights_file(text.substr(1), policy);
+    }
+    return parse_type_weights(text, policy);
+}
+
 Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& algorithm, const std::string& types,
-                          double time_limit, bool refine, const std::string& objective) {
+                          double time_limit, bool refine, const std::string& objective, const py::object& type_weights) {
     const Primitives primitives = joined(primitives_in);
     const std::optional<Algorithm> chosen = parse_algorithm(algorithm);
     if (!chosen) raise(Error{"unknown algorithm '" + algorithm + "' (see `hbvh algorithms`)"});
     Result<VolumePolicy> policy = parse_allowed_types(types);
+    if (!policy) raise(policy.error());
+    policy = with_type_weights(type_weights, policy.value());
     if (!policy) raise(policy.error());
     if (!(time_limit >= 0.0)) throw py::value_error("time_limit must be a number of seconds >= 0 (0: no limit)");
     if (objective != "eq2" && objective != "calibrated")
@@ -471,9 +494,10 @@ PYBIND11_MODULE(hbvh, m) {
           "one, else Primitives. format as the CLI's --format. A stored hierarchy whose volumes miss primitives is "
           "refused, or with refit=True repaired.");
     m.def("build", &build_hierarchy, "primitives"_a, "algorithm"_a = "auto", "types"_a = "aabb,obb,sphere,capsule",
-          "time_limit"_a = 0.0, "refine"_a = false, "objective"_a = "eq2",
+          "time_limit"_a = 0.0, "refine"_a = false, "objective"_a = "eq2", "type_weights"_a = py::none(),
           "Builds a Hierarchy over Primitives (or a list of them) with a registered builder (see algorithms()). "
-          "objective as the CLI's --objective: 'eq2' (the survey's Eq. 2) or 'calibrated'.");
+          "objective as the CLI's --objective: 'eq2' (the survey's Eq. 2) or 'calibrated'; type_weights as its "
+          "--type-weight: 'obb=1.3,capsule=1.2', '@FILE' (what `hbvh calibrate -o FILE` wrote) or a dict.");
     m.def("algorithms", [] {
         std::vector<std::string> names;
         for (const hbvh::AlgorithmInfo& info : hbvh::algorithms()) names.emplace_back(info.name);

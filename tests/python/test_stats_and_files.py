@@ -86,3 +86,32 @@ def test_the_calibrated_objective_builds_what_the_cli_builds(cli, tmp_path):
     assert_same_stats(by_minkowski.stats(), hbvh.load(str(path)).stats())
     with pytest.raises(ValueError, match="objective"):
         hbvh.build(primitives, "split", objective="fastest")
+
+
+def test_type_weights_are_the_clis_in_every_form(cli, tmp_path):
+    # type_weights= takes what --type-weight takes: a list, the file `hbvh calibrate -o` writes (its table of
+    # pairs as comments), or a dict; each gives the CLI's tree, and a bad entry is named with its file and line.
+    primitives = hbvh.load(str(MODELS / "tie_interceptor.xml"))
+    weights = tmp_path / "weights.txt"
+    weights.write_text("# ns per inner-node test\n#          aabb   obb\n# aabb    19.5  24.0\n"
+                       "aabb=1.000,obb=1.275,sphere=0.384,capsule=1.258\n")
+    from_file = hbvh.build(primitives, "split", objective="calibrated", type_weights="@" + str(weights))
+    from_list = hbvh.build(primitives, "split", objective="calibrated",
+                           type_weights="aabb=1,obb=1.275,sphere=0.384,capsule=1.258")
+    from_dict = hbvh.build(primitives, "split", objective="calibrated",
+                           type_weights={"obb": 1.275, "sphere": 0.384, "capsule": 1.258})
+    unweighted = hbvh.build(primitives, "split", objective="calibrated")
+    assert_same_stats(from_file.stats(), from_list.stats())
+    assert_same_stats(from_file.stats(), from_dict.stats())
+    assert from_file.stats()["types"] != unweighted.stats()["types"]  # the cheap spheres change the kinds chosen
+    path = tmp_path / "cli.xml"
+    result = run_cli(cli, "build", MODELS / "tie_interceptor.xml", "-a", "split", "--objective", "calibrated",
+                     "--type-weight", "@" + str(weights), "-o", path)
+    assert result.returncode == 0, result.stderr
+    assert_same_stats(from_file.stats(), hbvh.load(str(path)).stats())
+    bad = tmp_path / "bad.txt"
+    bad.write_text("aabb=1\nobb=heavy\n")
+    with pytest.raises(hbvh.Error, match=r"bad.txt:2: type weight 'obb=heavy' needs a positive finite number"):
+        hbvh.build(primitives, "split", type_weights="@" + str(bad))
+    with pytest.raises(hbvh.Error, match="unknown bounding-volume type"):
+        hbvh.build(primitives, "split", type_weights={"cone": 2.0})
