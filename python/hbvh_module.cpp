@@ -339,12 +339,7 @@ Result<VolumePolicy> with_type_weights(const py::object& weights, VolumePolicy p
     }
     if (!py::isinstance<py::str>(weights))
         throw py::value_error("type_weights must be a str ('obb=1.3,...' or '@FILE') or a dict, or None");
-    const std::string text = weights.cast<std::string>();
-    if (text.starts_with('@')) {
-        if (text.size() == 1) return Error{"type_weights '@' needs a file name after the @"};
-        return read_type_weights_file(text.substr(1), policy);
-    }
-    return parse_type_weights(text, policy);
+    return type_weights_from(weights.cast<std::string>(), policy);
 }
 
 Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& algorithm, const std::string& types,

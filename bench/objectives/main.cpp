@@ -329,9 +329,7 @@ int main(int argc, char** argv) {
         }
     }
     hbvh::Result<hbvh::VolumePolicy> calibrated =
-        options.type_weights.empty()        ? hbvh::VolumePolicy::all()
-        : options.type_weights.starts_with('@') ? hbvh::read_type_weights_file(options.type_weights.substr(1))
-                                                : hbvh::parse_type_weights(options.type_weights);
+        options.type_weights.empty() ? hbvh::VolumePolicy::all() : hbvh::type_weights_from(options.type_weights);
     if (!calibrated) {
         fmt::print(stderr, "hbvh_objectives: --type-weight: {}\n", calibrated.error().to_string());
         return 2;

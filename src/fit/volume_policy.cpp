@@ -91,4 +91,10 @@ Result<VolumePolicy> read_type_weights_file(const std::filesystem::path& path, V
     return base;
 }
 
+Result<VolumePolicy> type_weights_from(std::string_view list_or_file, VolumePolicy base) {
+    if (!list_or_file.starts_with('@')) return parse_type_weights(list_or_file, base);
+    if (list_or_file.size() == 1) return Error{"type weights: '@' needs a file name after it"};
+    return read_type_weights_file(std::filesystem::path(list_or_file.substr(1)), base);
+}
+
 }  // namespace hbvh

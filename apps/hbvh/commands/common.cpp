@@ -126,14 +126,8 @@ Result<BuildRequest> BuilderFlags::resolve() const {
     if (!chosen) return Error{"unknown algorithm '" + name + "' (see `hbvh algorithms`)"};
     Result<VolumePolicy> policy = parse_allowed_types(types);
     if (!policy) return policy.error();
-    if (!type_weights.empty()) {
-        // "@FILE": the weights `hbvh calibrate -o FILE` wrote.
-        if (type_weights.starts_with('@')) {
-            if (type_weights.size() == 1) return Error{"--type-weight @ needs a file name after the @"};
-            policy = read_type_weights_file(type_weights.substr(1), policy.value());
-        } else {
-            policy = parse_type_weights(type_weights, policy.value());
-        }
+    if (!type_weights.empty()) {  // a list, or "@FILE": the weights `hbvh calibrate -o FILE` wrote
+        policy = type_weights_from(type_weights, policy.value());
         if (!policy) return policy.error();
     }
     if (objective == "calibrated") policy->measure = NodeMeasure::minkowski;

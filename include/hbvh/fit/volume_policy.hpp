@@ -50,5 +50,8 @@ struct VolumePolicy {
 /// Reads the weights `hbvh calibrate -o FILE` writes: parse_type_weights' entries, separated by commas, blanks
 /// or lines, after '#' comments (its table of pairs) are dropped, a byte order mark allowed. Errors name the file.
 [[nodiscard]] Result<VolumePolicy> read_type_weights_file(const std::filesystem::path& path, VolumePolicy base = {});
+/// The CLI's --type-weight argument: "@FILE" reads read_type_weights_file(FILE), anything else is a list for
+/// parse_type_weights.
+[[nodiscard]] Result<VolumePolicy> type_weights_from(std::string_view list_or_file, VolumePolicy base = {});
 
 }  // namespace hbvh
