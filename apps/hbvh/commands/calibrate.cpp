@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <array>
 #include <span>
+#include <string_view>
 #include <utility>
 
 #include "commands/command.hpp"
@@ -55,21 +56,26 @@ double seconds_for(const QueryTree& a, const QueryTree& b, std::span<const Rigid
            static_cast<double>(poses.size());
 }
 
-/// The weights file: the pair table as comment lines (for the reader), then the weights in --type-weight syntax.
-std::string weights_file(const std::array<std::array<double, bv_type_count>, bv_type_count>& pair_ns,
-                         const std::string& weights) {
-    std::string text = "# hbvh calibrate: ns per inner-node test in the tandem traversal; row: this tree's kind,\n"
-                       "# column: the other tree's. A kind's weight is its diagonal entry over the AABB's.\n";
-    text += fmt::format("# {:<8}", "");
+using PairTable = std::array<std::array<double, bv_type_count>, bv_type_count>;  ///< ns, [this kind][the other's]
+
+/// The table of pairs, a header row and a row per kind, each line starting with `prefix`.
+std::string pair_table_text(const PairTable& pair_ns, std::string_view prefix) {
+    std::string text = fmt::format("{}{:<8}", prefix, "");
     for (BvType other : all_bv_types) text += fmt::format(" {:>8}", to_string(other));
     text += "\n";
     for (BvType type : all_bv_types) {
-        text += fmt::format("# {:<8}", to_string(type));
-        for (BvType other : all_bv_types)
-            text += fmt::format(" {:>8.2f}", pair_ns[static_cast<std::size_t>(type)][static_cast<std::size_t>(other)]);
+        text += fmt::format("{}{:<8}", prefix, to_string(type));
+        for (double ns : pair_ns[static_cast<std::size_t>(type)]) text += fmt::format(" {:>8.2f}", ns);
         text += "\n";
     }
-    return text + weights + "\n";
+    return text;
+}
+
+/// The weights file: the pair table as comment lines (for the reader), then the weights in --type-weight syntax.
+std::string weights_file(const PairTable& pair_ns, const std::string& weights) {
+    return "# hbvh calibrate: ns per inner-node test in the tandem traversal; row: this tree's kind,\n"
+           "# column: the other tree's. A kind's weight is its diagonal entry over the AABB's.\n" +
+           pair_table_text(pair_ns, "# ") + weights + "\n";
 }
 
 int run_calibrate(const CalibrateArguments& args) {
@@ -93,7 +99,7 @@ int run_calibrate(const CalibrateArguments& args) {
         if (!tree) return report_error(tree.error());
         trees.emplace_back(*tree);
     }
-    std::array<std::array<double, bv_type_count>, bv_type_count> pair_ns{};  // [this kind][the other's]
+    PairTable pair_ns{};
     for (std::size_t i = 0; i < bv_type_count; ++i)
         for (std::size_t j = 0; j < bv_type_count; ++j) {
             const auto [inner, leaf] = test_counts(trees[i], trees[j], poses, QueryMethod::tandem);
@@ -106,14 +112,8 @@ int run_calibrate(const CalibrateArguments& args) {
         return pair_ns[index][index];
     };
     const double aabb = self_ns(BvType::aabb);
-    fmt::print("ns per inner-node test (row: this tree's kind, column: the other tree's)\n{:<8}", "");
-    for (BvType other : all_bv_types) fmt::print(" {:>8}", to_string(other));
-    fmt::print("\n");
-    for (BvType type : all_bv_types) {
-        fmt::print("{:<8}", to_string(type));
-        for (double ns : pair_ns[static_cast<std::size_t>(type)]) fmt::print(" {:>8.2f}", ns);
-        fmt::print("\n");
-    }
+    fmt::print("ns per inner-node test (row: this tree's kind, column: the other tree's)\n{}",
+               pair_table_text(pair_ns, ""));
     std::string weights;
     fmt::print("\n{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
     for (BvType type : all_bv_types) {
