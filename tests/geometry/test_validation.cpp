@@ -104,6 +104,35 @@ TEST(ValidatePose, TheQuickCheckAgreesWithTheWordedOne) {
     }
 }
 
+TEST(ValidatePose, AgreesWithTheFullProductAwayFromTheTolerance) {
+    // The check computes six dot products of the columns, not R^T R; an independent oracle: Eigen's full
+    // product and determinant, on perturbed rotations (and a non-finite entry in every position). Where the
+    // oracle's measure lies within rounding of the tolerance either verdict is right, so those are skipped.
+    SplitMix64 rng(29);
+    int decided = 0;
+    for (int k = 0; k < 20000; ++k) {
+        RigidTransform pose{rng.rotation(), Vec3::Zero()};
+        const double size = std::pow(10.0, rng.uniform(-12.0, -6.0));
+        pose.rotation(static_cast<int>(rng.below(3)), static_cast<int>(rng.below(3))) += rng.uniform(-size, size);
+        if (k % 5 == 0) pose.rotation.col(1) = -pose.rotation.col(1);
+        const Mat3& r = pose.rotation;
+        const double orthogonality = (r.transpose() * r - Mat3::Identity()).cwiseAbs().maxCoeff();
+        const double determinant = std::abs(r.determinant() - 1.0);
+        const auto near_tolerance = [](double v) { return std::abs(v - rotation_tolerance) < 1e-14; };
+        if (near_tolerance(orthogonality) || near_tolerance(determinant)) continue;
+        ++decided;
+        EXPECT_EQ(is_rigid_motion(pose), orthogonality <= rotation_tolerance && determinant <= rotation_tolerance) << k;
+    }
+    EXPECT_GT(decided, 19000);
+    for (const double bad : {nan, std::numeric_limits<double>::infinity()})
+        for (int i = 0; i < 9; ++i) {
+            RigidTransform pose;
+            pose.rotation(i / 3, i % 3) = bad;
+            EXPECT_FALSE(is_rigid_motion(pose)) << bad << " at " << i;
+            EXPECT_NE(rotation_problem(pose.rotation).find("not finite"), std::string::npos);
+        }
+}
+
 TEST(FromQuaternion, NormalisesAndMatchesAnAxisAngleRotation) {
     // A quaternion scaled by 7: the same rotation as the unit one, here 90 degrees about y.
     const double h = std::sqrt(0.5);
