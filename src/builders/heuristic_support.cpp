@@ -14,6 +14,7 @@
 #include "hbvh/fit/fit.hpp"
 #include "../memory/huge_pages.hpp"
 #include "../memory/thread_scratch.hpp"
+#include "../fit/sphere_extents.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -151,14 +152,8 @@ namespace {
 // Box around the spheres in the frame `rotation` (columns = axes), given in that frame: its volume and the
 // calibrated measure are those of the OBB, both being invariant under rotation.
 Aabb box_in(std::span<const Sphere> spheres, const Mat3& rotation) {
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
-    Vec3 hi = -lo;
-    for (const Sphere& s : spheres) {
-        const Vec3 local = rotation.transpose() * s.center;
-        lo = lo.cwiseMin(local - Vec3::Constant(s.radius));
-        hi = hi.cwiseMax(local + Vec3::Constant(s.radius));
-    }
-    return {lo, hi};
+    const SphereExtents extents = sphere_extents(spheres, rotation);
+    return {extents.low, extents.high};
 }
 
 // Capsule on the line through `origin` along unit `axis`: the radius covers every sphere's distance from

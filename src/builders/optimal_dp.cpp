@@ -20,6 +20,7 @@
 #include <array>
 #include <limits>
 
+#include "../simd/wide_clones.hpp"
 #include "hbvh/assert.hpp"
 
 namespace hbvh {
@@ -37,14 +38,8 @@ constexpr std::uint32_t member_count(std::uint32_t mask) {
 }
 static_assert(member_count(0) == 0 && member_count(0xFFFFFFFFu) == 32 && member_count(0x80000101u) == 3);
 
-/// The two hot loops come in an AVX2 clone, picked at load time where the processor has it (the portable build
-/// targets plain x86-64): min and add on four doubles at once instead of two, the same operations on every
-/// element, so the tables are bit for bit the same either way.
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-#define HBVH_WIDE_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define HBVH_WIDE_CLONES
-#endif
+// The two hot loops below come in an AVX2 copy (simd/wide_clones.hpp): min and add on four doubles at once
+// instead of two, the same operations on every element, so the tables are bit for bit the same either way.
 
 /// From this many primitives on, the subsets of one size are solved in parallel (below, a task costs more
 /// than the work: treelets solve DPs of a few units).

@@ -14,6 +14,7 @@
 #include "../memory/thread_scratch.hpp"
 #include "hull_2d.hpp"
 #include "rounding_pad.hpp"
+#include "sphere_extents.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -348,44 +349,26 @@ Obb finish_box(std::span<const Sphere> spheres, const Mat3& rotation, const Vec3
 }  // namespace
 
 Obb obb_with_axes(std::span<const Sphere> spheres, const Mat3& rotation) {
-    const Mat3 to_local = rotation.transpose();
-    Vec3 low = Vec3::Constant(infinity);
-    Vec3 high = Vec3::Constant(-infinity);
-    for (const Sphere& s : spheres) {
-        const Vec3 local = to_local * s.center;
-        low = low.cwiseMin(local - Vec3::Constant(s.radius));
-        high = high.cwiseMax(local + Vec3::Constant(s.radius));
-    }
-    return finish_box(spheres, rotation, low, high);
+    const SphereExtents extents = sphere_extents(spheres, rotation);
+    return finish_box(spheres, rotation, extents.low, extents.high);
 }
 
 std::optional<Obb> obb_with_axes_below(std::span<const Sphere> spheres, const Mat3& rotation, double limit) {
-    const Mat3 to_local = rotation.transpose();
-    Vec3 low = Vec3::Constant(infinity);
-    Vec3 high = Vec3::Constant(-infinity);
-    for (std::size_t i = 0; i < spheres.size(); ++i) {
-        const Sphere& s = spheres[i];
-        const Vec3 local = to_local * s.center;
-        low = low.cwiseMin(local - Vec3::Constant(s.radius));
-        high = high.cwiseMax(local + Vec3::Constant(s.radius));
-        // The extent only grows, and the finished box only grows it further: once this product reaches the
-        // limit the box cannot end below it.
-        if (i % 8 == 7 && (high - low).prod() >= limit) return std::nullopt;
+    // The extent only grows, and the finished box only grows it further: once this product reaches the limit
+    // after a block of spheres, the box cannot end below it.
+    constexpr std::size_t block = 8;
+    SphereExtents extents;
+    for (std::size_t i = 0; i < spheres.size(); i += block) {
+        extend_extents(spheres.subspan(i, std::min(block, spheres.size() - i)), rotation, extents);
+        if ((extents.high - extents.low).prod() >= limit) return std::nullopt;
     }
-    if ((high - low).prod() >= limit) return std::nullopt;
-    return finish_box(spheres, rotation, low, high);
+    if ((extents.high - extents.low).prod() >= limit) return std::nullopt;
+    return finish_box(spheres, rotation, extents.low, extents.high);
 }
 
 double proxy_obb_volume(const SphereProxy& proxy, const Mat3& rotation) {
-    const Mat3 to_local = rotation.transpose();
-    Vec3 low = Vec3::Constant(infinity);
-    Vec3 high = Vec3::Constant(-infinity);
-    for (const Sphere& s : proxy.spheres) {
-        const Vec3 local = to_local * s.center;
-        low = low.cwiseMin(local - Vec3::Constant(s.radius));
-        high = high.cwiseMax(local + Vec3::Constant(s.radius));
-    }
-    return (high - low).prod();
+    const SphereExtents extents = sphere_extents(proxy.spheres, rotation);
+    return (extents.high - extents.low).prod();
 }
 
 Mat3 refine_frame(const SphereProxy& proxy, const Mat3& rotation) {

@@ -1,0 +1,31 @@
+// SPDX-License-Identifier: MIT
+// Internal: the extents of a set of spheres along the axes of a frame, the inner loop of every box fit.
+#pragma once
+
+#include <limits>
+#include <span>
+
+#include "hbvh/geometry/sphere.hpp"
+
+namespace hbvh::detail {
+
+/// Along each axis of a frame, the least and the greatest coordinate of the spheres' surfaces.
+struct SphereExtents {
+    Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
+    Vec3 high = Vec3::Constant(-std::numeric_limits<double>::infinity());
+};
+
+/// Folds `spheres` into `extents` along the columns of `frame` (any matrix; for a rotation, the extents of
+/// the box with those axes around the spheres, in the frame's coordinates). A centre's coordinate along
+/// axis i is (c.x frame(0, i) + c.y frame(1, i)) + c.z frame(2, i), in that order on every axis and in either
+/// of the function's two compiled copies (simd/wide_clones.hpp), so the result does not depend on the machine.
+void extend_extents(std::span<const Sphere> spheres, const Mat3& frame, SphereExtents& extents);
+
+/// The extents of `spheres` along the columns of `frame` (empty extents for no spheres).
+[[nodiscard]] inline SphereExtents sphere_extents(std::span<const Sphere> spheres, const Mat3& frame) {
+    SphereExtents extents;
+    extend_extents(spheres, frame, extents);
+    return extents;
+}
+
+}  // namespace hbvh::detail

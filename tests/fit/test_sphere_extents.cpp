@@ -1,0 +1,73 @@
+// SPDX-License-Identifier: MIT
+// sphere_extents, the loop under every box fit (four lanes at once where the processor has AVX2): against a
+// plain loop over the spheres that forms each coordinate in the documented order, bit for bit, and against
+// the exact extents in long double within rounding; folding the spheres in blocks gives the same extents.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "../../src/fit/sphere_extents.hpp"
+#include "support/test_helpers.hpp"
+
+namespace hbvh {
+namespace {
+
+using test_support::random_vector;
+
+TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) {
+    SplitMix64 rng(41);
+    for (int trial = 0; trial < 3000; ++trial) {
+        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
+        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
+        std::vector<Sphere> spheres;
+        const auto count = rng.below(50);  // none too: empty extents
+        for (std::uint64_t i = 0; i < count; ++i)
+            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        // A rotation, or any matrix (the fitters pass rotations; the loop must not assume one).
+        const Mat3 frame = trial % 4 == 3 ? Mat3(Mat3::Random()) : rng.rotation();
+        const detail::SphereExtents extents = detail::sphere_extents(spheres, frame);
+
+        Vec3 low = Vec3::Constant(std::numeric_limits<double>::infinity());
+        Vec3 high = -low;
+        for (const Sphere& s : spheres)
+            for (int axis = 0; axis < 3; ++axis) {
+                const double along = (s.center.x() * frame(0, axis) + s.center.y() * frame(1, axis)) +
+                                     s.center.z() * frame(2, axis);
+                low[axis] = std::min(low[axis], along - s.radius);
+                high[axis] = std::max(high[axis], along + s.radius);
+            }
+        ASSERT_EQ(extents.low, low) << trial;
+        ASSERT_EQ(extents.high, high) << trial;
+
+        // Independent of the order: each extent in long double, then compared within rounding of the coordinates.
+        for (int axis = 0; axis < 3; ++axis) {
+            long double exact_low = std::numeric_limits<long double>::infinity(), exact_high = -exact_low;
+            double magnitude = 0.0;
+            for (const Sphere& s : spheres) {
+                long double along = 0.0L;
+                for (int k = 0; k < 3; ++k) along += static_cast<long double>(s.center[k]) * frame(k, axis);
+                exact_low = std::min(exact_low, along - s.radius);
+                exact_high = std::max(exact_high, along + s.radius);
+                magnitude = std::max(magnitude, s.center.cwiseAbs().sum() * frame.col(axis).cwiseAbs().maxCoeff() + s.radius);
+            }
+            if (spheres.empty()) continue;
+            EXPECT_NEAR(static_cast<double>(exact_low), extents.low[axis], 1e-15 * magnitude) << trial;
+            EXPECT_NEAR(static_cast<double>(exact_high), extents.high[axis], 1e-15 * magnitude) << trial;
+        }
+
+        // Folded in blocks of any size: the same extents (min and max do not depend on the grouping).
+        detail::SphereExtents folded;
+        const std::size_t block = 1 + rng.below(9);
+        for (std::size_t i = 0; i < spheres.size(); i += block)
+            detail::extend_extents(std::span<const Sphere>(spheres).subspan(i, std::min(block, spheres.size() - i)),
+                                   frame, folded);
+        EXPECT_EQ(folded.low, extents.low) << trial;
+        EXPECT_EQ(folded.high, extents.high) << trial;
+    }
+}
+
+}  // namespace
+}  // namespace hbvh
