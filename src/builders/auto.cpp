@@ -2,11 +2,15 @@
 #include "hbvh/builders/auto.hpp"
 
 #include <algorithm>
+#include <atomic>
+#include <numeric>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include "guarded_build.hpp"
 #include "report_text.hpp"
@@ -69,7 +73,7 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     // Where every member is refined, each refines its tree as soon as it is built, without waiting for the
     // others' builds (a refinement depends on its tree only, so the trees are the same).
     const bool refine_each = refined_count >= members.size();
-    tbb::parallel_for(std::size_t{0}, members.size(), [&](std::size_t m) {
+    const auto run_member = [&](std::size_t m) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
         if (m > 0 && limited && context.expired()) return;
@@ -84,7 +88,23 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
         }
         outcome.tree = std::move(built);
         if (refine_each && *outcome.tree) refine_member(outcome);
+    };
+    // Each free worker takes the next member: a member's build and refinement take from one to tens of
+    // milliseconds, depending on what the shared cache already holds, and parallel_for's fixed halves of the
+    // list left one core idle for 10-15 ms at the end (the cannon, the Tie-Interceptor). The two slow builders
+    // go first, so that neither is what a core waits for at the end (docs/treelets.md §4). Which worker runs a
+    // member, and when, changes no tree.
+    std::vector<std::size_t> order(members.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::stable_partition(order.begin(), order.end(), [&](std::size_t m) {
+        return members[m] == Algorithm::scale || members[m] == Algorithm::insertion_haber;
     });
+    std::atomic<std::size_t> next_member{0};
+    const std::size_t workers = std::min<std::size_t>(members.size(), static_cast<std::size_t>(
+                                                                           tbb::this_task_arena::max_concurrency()));
+    tbb::parallel_for(std::size_t{0}, workers, [&](std::size_t) {
+        for (std::size_t k = next_member++; k < members.size(); k = next_member++) run_member(order[k]);
+    }, tbb::simple_partitioner());
     // The first error in list order ends the build; else the `refined_count` cheapest trees (list order on ties)
     // are refined.
     std::vector<std::size_t> built;
