@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "pair_tests.hpp"
+#include "../simd/wide_clones.hpp"
 
 namespace hbvh {
 namespace {
@@ -209,8 +210,11 @@ RigidTransform relative_transform(const RigidTransform& pose_a, const RigidTrans
     return {inverse_rotation * pose_b.rotation, inverse_rotation * (pose_b.translation - pose_a.translation)};
 }
 
-void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b, const RigidTransform& pose_b,
-             CollideMode mode, CollideResult& result, std::uint64_t flat_pair_limit) {
+// Compiled for AVX2 too, with the traversal and the node tests inlined (simd/wide_clones.hpp): 10-20 % less time
+// on small trees (docs/queries.md, "An AVX2 copy of the queries").
+HBVH_WIDE_CLONES_INLINED void collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
+                                      const RigidTransform& pose_b, CollideMode mode, CollideResult& result,
+                                      std::uint64_t flat_pair_limit) {
     detail::reset(result);
     if (!detail::poses_valid(pose_a, pose_b, result) || a.empty() || b.empty()) return;
     const RigidTransform t = relative_transform(pose_a, pose_b);

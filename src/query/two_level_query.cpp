@@ -4,11 +4,14 @@
 
 #include "hbvh/query/tandem_traversal.hpp"
 #include "pair_tests.hpp"
+#include "../simd/wide_clones.hpp"
 
 namespace hbvh {
 
-void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
-                       const RigidTransform& pose_b, CollideMode mode, CollideResult& result) {
+// Compiled as collide() is (an AVX2 copy with the leaf tests inlined), so that the two queries are compared on
+// equal terms.
+HBVH_WIDE_CLONES_INLINED void collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
+                                                const RigidTransform& pose_b, CollideMode mode, CollideResult& result) {
     detail::reset(result);
     if (!detail::poses_valid(pose_a, pose_b, result) || a.empty() || b.empty()) return;
     const RigidTransform t = relative_transform(pose_a, pose_b);

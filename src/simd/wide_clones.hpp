@@ -8,6 +8,13 @@
 /// both copies give the same bits and a tree does not depend on the machine that built it.
 #if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define HBVH_WIDE_CLONES __attribute__((target_clones("avx2", "default")))
+#define HBVH_WIDE_CLONES_INLINED __attribute__((target_clones("avx2", "default"), flatten))
 #else
 #define HBVH_WIDE_CLONES
+#define HBVH_WIDE_CLONES_INLINED
 #endif
+
+/// HBVH_WIDE_CLONES_INLINED also inlines into both copies every call it can (GCC's `flatten`): for an entry
+/// point whose hot code lives in headers, such as a query (its node tests, leaf loops and traversal), so that
+/// the AVX2 copy covers the whole of it and not just its first frame. Arithmetic is as written in either copy
+/// (AVX2 without FMA contracts nothing), so both give the same bits.
