@@ -15,6 +15,7 @@ extern "C" {
 }
 
 #include "../memory/thread_scratch.hpp"
+#include "../simd/wide_clones.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -66,7 +67,7 @@ std::vector<std::uint32_t> all_indices(std::size_t n) {
 
 }  // namespace
 
-bool outline_along(const HullSurface& surface, const Vec3& direction, OutlineScratch& scratch) {
+HBVH_WIDE_CLONES_INLINED bool outline_along(const HullSurface& surface, const Vec3& direction, OutlineScratch& scratch) {
     std::vector<std::uint32_t>& outline = scratch.outline;
     outline.clear();
     if (surface.empty()) return false;

@@ -12,6 +12,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "../memory/thread_scratch.hpp"
+#include "../simd/wide_clones.hpp"
 #include "hull_2d.hpp"
 #include "rounding_pad.hpp"
 #include "sphere_extents.hpp"
@@ -275,7 +276,7 @@ std::vector<Mat3> select_hints(const SphereProxy& proxy, std::span<const Mat3> h
     return selected;
 }
 
-std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals) {
+HBVH_WIDE_CLONES_INLINED std::vector<Mat3> face_flush_frames(const SphereProxy& proxy, std::span<const Vec3> normals) {
     std::vector<Mat3> frames;
     frames.reserve(normals.size());
     const double pad = 2.0 * proxy.max_radius;

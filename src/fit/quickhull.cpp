@@ -8,6 +8,8 @@
 #include <cmath>
 #include <limits>
 
+#include "../simd/wide_clones.hpp"
+
 namespace hbvh::detail {
 namespace {
 
@@ -336,7 +338,9 @@ private:
 
 }  // namespace
 
-std::optional<TriangleHull> quickhull(std::span<const Vec3> points, bool* flat_within_rounding) {
+// Compiled for AVX2 too, the steps inlined (simd/wide_clones.hpp), as are the other hot loops of a fit: the
+// outlines, the face-flush frames and the capsule's radius search (docs/fitting.md, "AVX2 copies").
+HBVH_WIDE_CLONES_INLINED std::optional<TriangleHull> quickhull(std::span<const Vec3> points, bool* flat_within_rounding) {
     // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel: half the
     // page faults of auto over the MuJoCo cards, and a tenth of its time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
     // largest hull that thread has built (at most quickhull_max_points points) and stay there.
