@@ -334,13 +334,10 @@ namespace {
 /// The box with axes `rotation` whose local extent is [low, high], grown until it contains every sphere as
 /// Obb::contains measures it (re-centring rounds), then padded.
 Obb finish_box(std::span<const Sphere> spheres, const Mat3& rotation, const Vec3& low, const Vec3& high) {
-    const Mat3 to_local = rotation.transpose();
     Obb box{rotation * (0.5 * (low + high)), rotation, 0.5 * (high - low)};
-    // Re-centring rounds; grow by whatever the containment test itself measures, so it holds exactly.
-    for (const Sphere& s : spheres) {
-        const Vec3 local = to_local * (s.center - box.center);
-        box.half_extents = box.half_extents.cwiseMax(Vec3(local.cwiseAbs().array() + s.radius));
-    }
+    // Re-centring rounds; grow by what each sphere reaches from the new centre, as the containment test measures
+    // it (up to the order of a sum, which the pad below covers).
+    extend_half_extents(spheres, rotation, box.center, box.half_extents);
     // Local coordinates are differences of nearby points, so their rounding scales with the box, not
     // with its distance from the origin.
     box.half_extents.array() += rounding_pad(box.half_extents.maxCoeff());

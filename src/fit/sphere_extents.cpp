@@ -32,4 +32,20 @@ HBVH_WIDE_CLONES void extend_extents(std::span<const Sphere> spheres, const Mat3
     extents.high = Vec3(high[0], high[1], high[2]);
 }
 
+HBVH_WIDE_CLONES void extend_half_extents(std::span<const Sphere> spheres, const Mat3& frame, const Vec3& center,
+                                          Vec3& half_extents) {
+    const Lanes along_x{frame(0, 0), frame(0, 1), frame(0, 2), 0.0};
+    const Lanes along_y{frame(1, 0), frame(1, 1), frame(1, 2), 0.0};
+    const Lanes along_z{frame(2, 0), frame(2, 1), frame(2, 2), 0.0};
+    Lanes half{half_extents.x(), half_extents.y(), half_extents.z(), 0.0};
+    for (const Sphere& s : spheres) {
+        const double x = s.center.x() - center.x(), y = s.center.y() - center.y(), z = s.center.z() - center.z();
+        const double r = s.radius;
+        const Lanes local = (Lanes{x, x, x, x} * along_x + Lanes{y, y, y, y} * along_y) + Lanes{z, z, z, z} * along_z;
+        const Lanes reach = (local < 0.0 ? -local : local) + Lanes{r, r, r, r};
+        half = reach > half ? reach : half;
+    }
+    half_extents = Vec3(half[0], half[1], half[2]);
+}
+
 }  // namespace hbvh::detail

@@ -21,6 +21,12 @@ struct SphereExtents {
 /// of the function's two compiled copies (simd/wide_clones.hpp), so the result does not depend on the machine.
 void extend_extents(std::span<const Sphere> spheres, const Mat3& frame, SphereExtents& extents);
 
+/// Grows `half_extents` to each sphere's reach from `center` along the columns of `frame`: per axis i, the
+/// largest |d . frame.col(i)| + radius, d = c - center, the dot product formed as extend_extents forms it. The
+/// box fits' last pass (a box with those axes, centred there, then holds every sphere up to rounding, which
+/// their pad covers).
+void extend_half_extents(std::span<const Sphere> spheres, const Mat3& frame, const Vec3& center, Vec3& half_extents);
+
 /// The extents of `spheres` along the columns of `frame` (empty extents for no spheres).
 [[nodiscard]] inline SphereExtents sphere_extents(std::span<const Sphere> spheres, const Mat3& frame) {
     SphereExtents extents;

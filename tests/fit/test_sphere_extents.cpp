@@ -69,5 +69,47 @@ TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) 
     }
 }
 
+TEST(SphereExtents, HalfExtentsFromACentreMatchAPlainLoopAndTheExactReach) {
+    SplitMix64 rng(43);
+    for (int trial = 0; trial < 3000; ++trial) {
+        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
+        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
+        std::vector<Sphere> spheres;
+        const auto count = 1 + rng.below(50);
+        for (std::uint64_t i = 0; i < count; ++i)
+            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        const Mat3 frame = rng.rotation();
+        const Vec3 center = offset + random_vector(rng, 0.1 * scale);
+        const Vec3 start = Vec3(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)) * scale;
+        Vec3 half = start;
+        detail::extend_half_extents(spheres, frame, center, half);
+
+        Vec3 expected = start;
+        for (const Sphere& s : spheres) {
+            const Vec3 d = s.center - center;
+            for (int axis = 0; axis < 3; ++axis) {
+                const double along = (d.x() * frame(0, axis) + d.y() * frame(1, axis)) + d.z() * frame(2, axis);
+                expected[axis] = std::max(expected[axis], std::abs(along) + s.radius);
+            }
+        }
+        ASSERT_EQ(half, expected) << trial;
+
+        // Against the reach in long double, and the box it makes holds every sphere as Obb::contains measures it
+        // once padded by the fitters' rounding pad (four units in the last place of the largest half extent).
+        for (int axis = 0; axis < 3; ++axis) {
+            long double reach = start[axis];
+            for (const Sphere& s : spheres) {
+                long double along = 0.0L;
+                for (int k = 0; k < 3; ++k)
+                    along += (static_cast<long double>(s.center[k]) - center[k]) * frame(k, axis);
+                reach = std::max(reach, std::abs(along) + s.radius);
+            }
+            EXPECT_NEAR(static_cast<double>(reach), half[axis], 1e-15 * (half.maxCoeff() + scale)) << trial;
+        }
+        const Obb box{center, frame, half.array() + half.maxCoeff() * 0x1.0p-50};
+        for (const Sphere& s : spheres) EXPECT_TRUE(box.contains(s)) << trial;
+    }
+}
+
 }  // namespace
 }  // namespace hbvh
