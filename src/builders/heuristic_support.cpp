@@ -159,15 +159,8 @@ Aabb box_in(std::span<const Sphere> spheres, const Mat3& rotation) {
 // Capsule on the line through `origin` along unit `axis`: the radius covers every sphere's distance from
 // the line, the segment spans the centres' projections, so every sphere is inside.
 Capsule capsule_around_line(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
-    double radius = 0.0, t_min = std::numeric_limits<double>::infinity(), t_max = -t_min;
-    for (const Sphere& s : spheres) {
-        const Vec3 d = s.center - origin;
-        const double t = d.dot(axis);
-        radius = std::max(radius, (d - t * axis).norm() + s.radius);
-        t_min = std::min(t_min, t);
-        t_max = std::max(t_max, t);
-    }
-    return Capsule{origin + t_min * axis, origin + t_max * axis, radius};
+    const LineReach reach = line_reach(spheres, origin, axis);
+    return Capsule{origin + reach.t_min * axis, origin + reach.t_max * axis, reach.radius};
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 
 #include "frames.hpp"
 #include "rounding_pad.hpp"
+#include "sphere_extents.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/fit/fit.hpp"
@@ -24,20 +25,11 @@ namespace {
 /// The capsule on the line through `origin` along unit `axis` whose radius covers every sphere's distance
 /// from the line and whose segment spans the centres' projections, so every sphere is inside.
 Capsule capsule_on(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
-    double radius = 0.0;
-    double t_min = std::numeric_limits<double>::infinity();
-    double t_max = -t_min;
-    for (const Sphere& s : spheres) {
-        const Vec3 d = s.center - origin;
-        const double t = d.dot(axis);
-        radius = std::max(radius, (d - t * axis).norm() + s.radius);
-        t_min = std::min(t_min, t);
-        t_max = std::max(t_max, t);
-    }
+    const detail::LineReach reach = detail::line_reach(spheres, origin, axis);
     // A few ulps of slack: Capsule::contains measures the distance through the clamped segment point,
     // which rounds differently from the line distance above.
-    radius += radius * 0x1.0p-48;
-    return Capsule{origin + t_min * axis, origin + t_max * axis, radius};
+    const double radius = reach.radius + reach.radius * 0x1.0p-48;
+    return Capsule{origin + reach.t_min * axis, origin + reach.t_max * axis, radius};
 }
 
 /// A sphere around `spheres` centred at the better of two cheap centres (world-box centre, mean centre):

@@ -1,13 +1,16 @@
 // SPDX-License-Identifier: MIT
 #include "sphere_extents.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "../simd/wide_clones.hpp"
 
 namespace hbvh::detail {
 namespace {
 
-/// Four doubles: x, y, z and a lane that is computed and ignored. GCC's vector extension, so that the
-/// AVX2 copy works on one register where the plain copy works on two.
+/// Four doubles: a point's x, y, z and a lane that is computed and ignored, or one coordinate of four spheres.
+/// GCC's vector extension, so that the AVX2 copy works on one register where the plain copy works on two.
 typedef double Lanes __attribute__((vector_size(32)));
 
 }  // namespace
@@ -46,6 +49,59 @@ HBVH_WIDE_CLONES void extend_half_extents(std::span<const Sphere> spheres, const
         half = reach > half ? reach : half;
     }
     half_extents = Vec3(half[0], half[1], half[2]);
+}
+
+HBVH_WIDE_CLONES LineReach line_reach(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
+    // Four spheres at a time: their records (x, y, z, radius) transposed into one register per coordinate, so
+    // that every lane is one sphere and does the scalar tail's operations in its order.
+    const double ox = origin.x(), oy = origin.y(), oz = origin.z();
+    const double ax = axis.x(), ay = axis.y(), az = axis.z();
+    const std::size_t blocks = spheres.size() / 4;
+    Lanes radius{0.0, 0.0, 0.0, 0.0};
+    constexpr double infinity = std::numeric_limits<double>::infinity();
+    Lanes t_min{infinity, infinity, infinity, infinity};
+    Lanes t_max = -t_min;
+    for (std::size_t b = 0; b < blocks; ++b) {
+        Lanes record[4];
+        for (int k = 0; k < 4; ++k) {
+            const Sphere& s = spheres[4 * b + static_cast<std::size_t>(k)];
+            record[k] = Lanes{s.center.x(), s.center.y(), s.center.z(), s.radius};
+        }
+        using Index = long long __attribute__((vector_size(32)));
+        const Lanes low_01 = __builtin_shuffle(record[0], record[1], Index{0, 4, 2, 6});   // x0 x1 z0 z1
+        const Lanes high_01 = __builtin_shuffle(record[0], record[1], Index{1, 5, 3, 7});  // y0 y1 r0 r1
+        const Lanes low_23 = __builtin_shuffle(record[2], record[3], Index{0, 4, 2, 6});
+        const Lanes high_23 = __builtin_shuffle(record[2], record[3], Index{1, 5, 3, 7});
+        const Lanes x = __builtin_shuffle(low_01, low_23, Index{0, 1, 4, 5});
+        const Lanes z = __builtin_shuffle(low_01, low_23, Index{2, 3, 6, 7});
+        const Lanes y = __builtin_shuffle(high_01, high_23, Index{0, 1, 4, 5});
+        const Lanes r = __builtin_shuffle(high_01, high_23, Index{2, 3, 6, 7});
+        const Lanes dx = x - ox, dy = y - oy, dz = z - oz;
+        const Lanes t = (dx * ax + dy * ay) + dz * az;
+        const Lanes ex = dx - t * ax, ey = dy - t * ay, ez = dz - t * az;
+        const Lanes squared = (ex * ex + ey * ey) + ez * ez;
+        Lanes distance;
+        for (int k = 0; k < 4; ++k) distance[k] = std::sqrt(squared[k]);
+        const Lanes reach = distance + r;
+        radius = reach > radius ? reach : radius;
+        t_min = t < t_min ? t : t_min;
+        t_max = t > t_max ? t : t_max;
+    }
+    LineReach out;
+    for (int k = 0; k < 4; ++k) {
+        out.radius = std::max(out.radius, radius[k]);
+        out.t_min = std::min(out.t_min, t_min[k]);
+        out.t_max = std::max(out.t_max, t_max[k]);
+    }
+    for (const Sphere& s : spheres.subspan(4 * blocks)) {
+        const double dx = s.center.x() - ox, dy = s.center.y() - oy, dz = s.center.z() - oz;
+        const double t = (dx * ax + dy * ay) + dz * az;
+        const double ex = dx - t * ax, ey = dy - t * ay, ez = dz - t * az;
+        out.radius = std::max(out.radius, std::sqrt((ex * ex + ey * ey) + ez * ez) + s.radius);
+        out.t_min = std::min(out.t_min, t);
+        out.t_max = std::max(out.t_max, t);
+    }
+    return out;
 }
 
 }  // namespace hbvh::detail

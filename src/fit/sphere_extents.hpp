@@ -27,6 +27,18 @@ void extend_extents(std::span<const Sphere> spheres, const Mat3& frame, SphereEx
 /// their pad covers).
 void extend_half_extents(std::span<const Sphere> spheres, const Mat3& frame, const Vec3& center, Vec3& half_extents);
 
+/// How far `spheres` reach around the line through `origin` along unit `axis`: the largest distance of a sphere's
+/// surface from the line, and the least and greatest position of a centre along it. With d = c - origin, a
+/// centre's position is t = (d.x a.x + d.y a.y) + d.z a.z, and its distance sqrt((e.x^2 + e.y^2) + e.z^2) for
+/// e = d - t a, in that order in both compiled copies. The capsule on that line over [t_min, t_max] with that
+/// radius holds every sphere (up to rounding, which the callers pad).
+struct LineReach {
+    double radius = 0.0;
+    double t_min = std::numeric_limits<double>::infinity();
+    double t_max = -std::numeric_limits<double>::infinity();
+};
+[[nodiscard]] LineReach line_reach(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis);
+
 /// The extents of `spheres` along the columns of `frame` (empty extents for no spheres).
 [[nodiscard]] inline SphereExtents sphere_extents(std::span<const Sphere> spheres, const Mat3& frame) {
     SphereExtents extents;
