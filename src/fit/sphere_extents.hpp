@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Internal: the extents of a set of spheres along the axes of a frame, the inner loop of every box fit.
+// Internal: how far a set of spheres reaches along the axes of a frame or around a line, the inner loops of the
+// box and capsule fits.
 #pragma once
 
 #include <limits>
