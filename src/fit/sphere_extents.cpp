@@ -52,8 +52,9 @@ HBVH_WIDE_CLONES void extend_half_extents(std::span<const Sphere> spheres, const
 }
 
 HBVH_WIDE_CLONES LineReach line_reach(std::span<const Sphere> spheres, const Vec3& origin, const Vec3& axis) {
-    // Four spheres at a time: their records (x, y, z, radius) transposed into one register per coordinate, so
-    // that every lane is one sphere and does the scalar tail's operations in its order.
+    // Four spheres at a time, one register per coordinate, so that every lane is one sphere and does the scalar
+    // tail's operations in its order. (The registers are filled element by element: a shuffle would be GCC's
+    // __builtin_shuffle or Clang's __builtin_shufflevector, and the fuzz targets build this file with Clang.)
     const double ox = origin.x(), oy = origin.y(), oz = origin.z();
     const double ax = axis.x(), ay = axis.y(), az = axis.z();
     const std::size_t blocks = spheres.size() / 4;
@@ -62,20 +63,14 @@ HBVH_WIDE_CLONES LineReach line_reach(std::span<const Sphere> spheres, const Vec
     Lanes t_min{infinity, infinity, infinity, infinity};
     Lanes t_max = -t_min;
     for (std::size_t b = 0; b < blocks; ++b) {
-        Lanes record[4];
-        for (int k = 0; k < 4; ++k) {
-            const Sphere& s = spheres[4 * b + static_cast<std::size_t>(k)];
-            record[k] = Lanes{s.center.x(), s.center.y(), s.center.z(), s.radius};
-        }
-        using Index = long long __attribute__((vector_size(32)));
-        const Lanes low_01 = __builtin_shuffle(record[0], record[1], Index{0, 4, 2, 6});   // x0 x1 z0 z1
-        const Lanes high_01 = __builtin_shuffle(record[0], record[1], Index{1, 5, 3, 7});  // y0 y1 r0 r1
-        const Lanes low_23 = __builtin_shuffle(record[2], record[3], Index{0, 4, 2, 6});
-        const Lanes high_23 = __builtin_shuffle(record[2], record[3], Index{1, 5, 3, 7});
-        const Lanes x = __builtin_shuffle(low_01, low_23, Index{0, 1, 4, 5});
-        const Lanes z = __builtin_shuffle(low_01, low_23, Index{2, 3, 6, 7});
-        const Lanes y = __builtin_shuffle(high_01, high_23, Index{0, 1, 4, 5});
-        const Lanes r = __builtin_shuffle(high_01, high_23, Index{2, 3, 6, 7});
+        const Sphere& s0 = spheres[4 * b];
+        const Sphere& s1 = spheres[4 * b + 1];
+        const Sphere& s2 = spheres[4 * b + 2];
+        const Sphere& s3 = spheres[4 * b + 3];
+        const Lanes x{s0.center.x(), s1.center.x(), s2.center.x(), s3.center.x()};
+        const Lanes y{s0.center.y(), s1.center.y(), s2.center.y(), s3.center.y()};
+        const Lanes z{s0.center.z(), s1.center.z(), s2.center.z(), s3.center.z()};
+        const Lanes r{s0.radius, s1.radius, s2.radius, s3.radius};
         const Lanes dx = x - ox, dy = y - oy, dz = z - oz;
         const Lanes t = (dx * ax + dy * ay) + dz * az;
         const Lanes ex = dx - t * ax, ey = dy - t * ay, ez = dz - t * az;
