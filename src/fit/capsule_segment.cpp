@@ -8,8 +8,6 @@
 
 #include <Eigen/Core>
 
-#include "../simd/wide_clones.hpp"
-
 namespace hbvh::detail {
 
 std::pair<double, double> segment_ends(const AxisDistances& a, double radius) {
@@ -40,7 +38,7 @@ std::pair<double, double> segment_ends(const AxisDistances& a, double radius) {
     return {t0, t1};
 }
 
-HBVH_WIDE_CLONES_INLINED std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
+std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
     auto [t0, t1] = segment_ends(a, radius);
     if (t1 < t0) t0 = t1 = 0.5 * (t0 + t1);
     return {t0, t1};

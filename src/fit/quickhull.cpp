@@ -338,8 +338,8 @@ private:
 
 }  // namespace
 
-// Compiled for AVX2 too, the steps inlined (simd/wide_clones.hpp), as are the other hot loops of a fit: the
-// outlines, the face-flush frames and the capsule's radius search (docs/fitting.md, "AVX2 copies").
+// Compiled for AVX2 too, the steps inlined (simd/wide_clones.hpp), as are two other hot loops of a fit: the
+// outlines and the face-flush frames (docs/fitting.md, "AVX2 copies").
 HBVH_WIDE_CLONES_INLINED std::optional<TriangleHull> quickhull(std::span<const Vec3> points, bool* flat_within_rounding) {
     // Fresh arrays on every call grew into memory that the allocator had just returned to the kernel: half the
     // page faults of auto over the MuJoCo cards, and a tenth of its time (docs/fitting.md, "Own hull"). Kept per thread, they reach the
