@@ -331,8 +331,8 @@ HBVH_WIDE_CLONES_INLINED std::vector<Mat3> face_flush_frames(const SphereProxy& 
 
 namespace {
 
-/// The box with axes `rotation` whose local extent is [low, high], grown until it contains every sphere as
-/// Obb::contains measures it (re-centring rounds), then padded.
+/// The box with axes `rotation` whose local extent is [low, high], grown to every sphere's reach from its
+/// centre (re-centring rounds), then padded for the rounding of the containment test's own arithmetic.
 Obb finish_box(std::span<const Sphere> spheres, const Mat3& rotation, const Vec3& low, const Vec3& high) {
     Obb box{rotation * (0.5 * (low + high)), rotation, 0.5 * (high - low)};
     // Re-centring rounds; grow by what each sphere reaches from the new centre, as the containment test measures
