@@ -14,6 +14,7 @@
 namespace hbvh {
 namespace {
 
+using test_support::random_spheres;
 using test_support::random_vector;
 
 TEST(ObbWithAxesBelow, ReturnsTheSameBoxOrOneNotBelowTheLimit) {
@@ -23,10 +24,8 @@ TEST(ObbWithAxesBelow, ReturnsTheSameBoxOrOneNotBelowTheLimit) {
     for (int trial = 0; trial < 2000; ++trial) {
         const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
         const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e4) * scale);
-        std::vector<Sphere> spheres;
         const auto count = 1 + rng.below(40);
-        for (std::uint64_t i = 0; i < count; ++i)
-            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Mat3 rotation = rng.rotation();
         const Obb exact = detail::obb_with_axes(spheres, rotation);
         const double v = exact.volume();

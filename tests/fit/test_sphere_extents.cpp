@@ -16,6 +16,7 @@
 namespace hbvh {
 namespace {
 
+using test_support::random_spheres;
 using test_support::random_vector;
 
 TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) {
@@ -23,10 +24,8 @@ TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) 
     for (int trial = 0; trial < 3000; ++trial) {
         const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
         const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
-        std::vector<Sphere> spheres;
         const auto count = rng.below(50);  // none too: empty extents
-        for (std::uint64_t i = 0; i < count; ++i)
-            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         // A rotation, or any matrix (the fitters pass rotations; the loop must not assume one).
         const Mat3 frame = trial % 4 == 3 ? Mat3(Mat3::Random()) : rng.rotation();
         const detail::SphereExtents extents = detail::sphere_extents(spheres, frame);
@@ -75,10 +74,8 @@ TEST(SphereExtents, HalfExtentsFromACentreMatchAPlainLoopAndTheExactReach) {
     for (int trial = 0; trial < 3000; ++trial) {
         const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
         const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
-        std::vector<Sphere> spheres;
         const auto count = 1 + rng.below(50);
-        for (std::uint64_t i = 0; i < count; ++i)
-            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Mat3 frame = rng.rotation();
         const Vec3 center = offset + random_vector(rng, 0.1 * scale);
         const Vec3 start = Vec3(rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0), rng.uniform(0.0, 1.0)) * scale;
@@ -119,10 +116,8 @@ TEST(SphereExtents, LineReachMatchesAPlainLoopAndTheExactDistances) {
     for (int trial = 0; trial < 3000; ++trial) {
         const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
         const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
-        std::vector<Sphere> spheres;
         const auto count = trial < 140 ? static_cast<std::uint64_t>(trial % 14) : rng.below(60);
-        for (std::uint64_t i = 0; i < count; ++i)
-            spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+        const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Vec3 origin = offset + random_vector(rng, 0.2 * scale);
         const Vec3 axis = rng.rotation().col(0);
         const detail::LineReach reach = detail::line_reach(spheres, origin, axis);

@@ -1,6 +1,6 @@
 // SPDX-License-Identifier: MIT
-// Small helpers more than one test file needs: random vectors from the seeded generator, and a bottom-up
-// level over primitives as they are (one node per primitive).
+// Small helpers more than one test file needs: random vectors and sphere sets from the seeded generator, and a
+// bottom-up level over primitives as they are (one node per primitive).
 #pragma once
 
 #include <cstdint>
@@ -17,6 +17,15 @@ namespace hbvh::test_support {
 inline Vec3 random_vector(SplitMix64& rng, double half_width) {
     return {rng.uniform(-half_width, half_width), rng.uniform(-half_width, half_width),
             rng.uniform(-half_width, half_width)};
+}
+
+/// `count` spheres with centres in the cube of half-width `scale` around `offset`, about a third of them points
+/// (radius 0) and the rest of radius up to 0.3 scale: the sets the fitters' loop tests draw.
+inline std::vector<Sphere> random_spheres(SplitMix64& rng, std::uint64_t count, const Vec3& offset, double scale) {
+    std::vector<Sphere> spheres;
+    for (std::uint64_t i = 0; i < count; ++i)
+        spheres.push_back({offset + random_vector(rng, scale), rng.below(3) == 0 ? 0.0 : rng.uniform(0.0, 0.3) * scale});
+    return spheres;
 }
 
 /// `primitives` in a seeded random order (Fisher-Yates).
