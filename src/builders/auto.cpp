@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <mutex>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -49,6 +50,48 @@ std::size_t members_to_refine(std::size_t primitive_count, std::size_t member_co
     return options.refine_always ? 1 : 0;
 }
 
+/// Where only the `refined` cheapest unrefined trees are refined, which ones is known only when every member has
+/// built, yet some are certain sooner: a member is among them once enough finished members rank after it
+/// (costlier, or as costly and later in the list, as the final ranking breaks ties), since then no costs of the
+/// unfinished ones can push it out. Its refinement then starts at once instead of after the slowest build. Which
+/// trees are refined, and so every tree, stays the same; only when changes (docs/treelets.md §4).
+class EarlyRefinements {
+public:
+    EarlyRefinements(std::size_t members, std::size_t refined)
+        : finished_(members, false), claimed_(members, false), costs_(members, 0.0),
+          ranked_after_needed_(members - std::min(refined, members)) {}
+
+    /// Records that member `m` built a tree of cost `cost`, and returns the members now certain to be refined
+    /// that no worker has taken yet, taken for the caller.
+    std::vector<std::size_t> finish(std::size_t m, double cost) {
+        const std::scoped_lock lock(mutex_);
+        finished_[m] = true;
+        costs_[m] = cost;
+        std::vector<std::size_t> taken;
+        if (ranked_after_needed_ == finished_.size()) return taken;  // nothing is refined
+        for (std::size_t i = 0; i < finished_.size(); ++i) {
+            if (!finished_[i] || claimed_[i]) continue;
+            std::size_t ranked_after = 0;
+            for (std::size_t j = 0; j < finished_.size(); ++j)
+                if (j != i && finished_[j] && (costs_[j] > costs_[i] || (costs_[j] == costs_[i] && j > i))) ++ranked_after;
+            if (ranked_after >= ranked_after_needed_) {
+                claimed_[i] = true;
+                taken.push_back(i);
+            }
+        }
+        return taken;
+    }
+
+    /// Whether member `m`'s refinement was taken by a worker (read once the workers are done).
+    [[nodiscard]] bool taken(std::size_t m) const { return claimed_[m]; }
+
+private:
+    std::mutex mutex_;
+    std::vector<bool> finished_, claimed_;
+    std::vector<double> costs_;
+    std::size_t ranked_after_needed_;
+};
+
 /// `auto`: every member of auto_portfolio(n) builds a tree, the cheapest few under Eq. 2 are refined
 /// (members_to_refine: all of them up to auto_refine_each_max_primitives, since refinement from different starts
 /// ends in different local optima, docs/treelets.md §3), and the cheapest refined tree wins (first in the list on
@@ -73,6 +116,7 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     // Where every member is refined, each refines its tree as soon as it is built, without waiting for the
     // others' builds (a refinement depends on its tree only, so the trees are the same).
     const bool refine_each = refined_count >= members.size();
+    EarlyRefinements early(members.size(), refined_count);
     const auto run_member = [&](std::size_t m) {
         // Under a time limit the members share it: each gets what is left (and stops at its own checks), and
         // once nothing is left the rest are skipped (the first always runs, so there is a tree).
@@ -87,7 +131,12 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
             outcome.costs = std::string(to_string(members[m])) + " " + detail::format_cost(outcome.cost);
         }
         outcome.tree = std::move(built);
-        if (refine_each && *outcome.tree) refine_member(outcome);
+        if (!*outcome.tree) return;
+        if (refine_each) {
+            refine_member(outcome);
+            return;
+        }
+        for (const std::size_t certain : early.finish(m, outcome.cost)) refine_member(outcomes[certain]);
     };
     // Each free worker takes the next member: a member's build and refinement take from one to tens of
     // milliseconds, depending on what the shared cache already holds, and parallel_for's fixed halves of the
@@ -118,7 +167,9 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
                      [&](std::size_t a, std::size_t b) { return outcomes[a].cost < outcomes[b].cost; });
     const std::size_t refine = std::min(refined_count, built.size());
     if (!refine_each)
-        tbb::parallel_for(std::size_t{0}, refine, [&](std::size_t r) { refine_member(outcomes[built[r]]); });
+        tbb::parallel_for(std::size_t{0}, refine, [&](std::size_t r) {
+            if (!early.taken(built[r])) refine_member(outcomes[built[r]]);
+        });
     // The callback is called from the calling thread only (BuildContext::progress), so once the members are done.
     context.report_progress(static_cast<double>(members.size()) / static_cast<double>(members.size() + 1));
 
