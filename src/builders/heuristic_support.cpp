@@ -172,30 +172,47 @@ double estimate_weighted_volume(std::span<const Sphere> spheres, std::span<const
     // Candidates are measured as the policy measures a node (volume, or the calibrated objective's measure).
     const auto measure = [&](const BoundingVolume& candidate) { return policy.unweighted_measure(candidate); };
     const auto consider = [&](BvType type, double v) { best = std::min(best, policy.weight_of(type) * v); };
-    if (policy.is_allowed(BvType::aabb)) consider(BvType::aabb, measure(fit_aabb(spheres)));
-    if (policy.is_allowed(BvType::sphere)) consider(BvType::sphere, measure(fit_sphere(spheres)));
-    if (!policy.is_allowed(BvType::obb) && !policy.is_allowed(BvType::capsule)) return best;
+    // The widest extent seen along any axis tried: the enclosing sphere is at least that wide.
+    const Aabb world_box = fit_aabb(spheres);
+    double widest = (world_box.max - world_box.min).maxCoeff();
+    if (policy.is_allowed(BvType::aabb)) consider(BvType::aabb, measure(world_box));
 
-    // Principal axes of the centres (weighted equally), as Gottschalk's covariance fit but without a hull.
-    Vec3 mean = Vec3::Zero();
-    for (const Sphere& s : spheres) mean += s.center;
-    mean /= static_cast<double>(spheres.size());
-    Mat3 covariance = Mat3::Zero();
-    for (const Sphere& s : spheres) covariance += (s.center - mean) * (s.center - mean).transpose();
-    const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);
-    const Mat3 principal = eigen.eigenvectors();  // columns ascending by eigenvalue; last = main axis
-    if (policy.is_allowed(BvType::obb)) {
-        double v = std::min(measure(box_in(spheres, Mat3::Identity())), measure(box_in(spheres, principal)));
-        for (const BoundingVolume& hint : hints)
-            if (const Obb* box = std::get_if<Obb>(&hint)) v = std::min(v, measure(box_in(spheres, box->rotation)));
-        consider(BvType::obb, v);
+    if (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule)) {
+        // Principal axes of the centres (weighted equally), as Gottschalk's covariance fit but without a hull.
+        Vec3 mean = Vec3::Zero();
+        for (const Sphere& s : spheres) mean += s.center;
+        mean /= static_cast<double>(spheres.size());
+        Mat3 covariance = Mat3::Zero();
+        for (const Sphere& s : spheres) covariance += (s.center - mean) * (s.center - mean).transpose();
+        const Eigen::SelfAdjointEigenSolver<Mat3> eigen(covariance);
+        const Mat3 principal = eigen.eigenvectors();  // columns ascending by eigenvalue; last = main axis
+        if (policy.is_allowed(BvType::obb)) {
+            const Aabb principal_box = box_in(spheres, principal);
+            widest = std::max(widest, (principal_box.max - principal_box.min).maxCoeff());
+            double v = std::min(measure(box_in(spheres, Mat3::Identity())), measure(principal_box));
+            for (const BoundingVolume& hint : hints)
+                if (const Obb* box = std::get_if<Obb>(&hint)) v = std::min(v, measure(box_in(spheres, box->rotation)));
+            consider(BvType::obb, v);
+        }
+        if (policy.is_allowed(BvType::capsule)) {
+            double v = measure(capsule_around_line(spheres, mean, principal.col(2)));
+            for (const BoundingVolume& hint : hints)
+                if (const Capsule* capsule = std::get_if<Capsule>(&hint))
+                    v = std::min(v, measure(capsule_around_line(spheres, capsule->center(), capsule->direction())));
+            consider(BvType::capsule, v);
+        }
     }
-    if (policy.is_allowed(BvType::capsule)) {
-        double v = measure(capsule_around_line(spheres, mean, principal.col(2)));
-        for (const BoundingVolume& hint : hints)
-            if (const Capsule* capsule = std::get_if<Capsule>(&hint))
-                v = std::min(v, measure(capsule_around_line(spheres, capsule->center(), capsule->direction())));
-        consider(BvType::capsule, v);
+
+    // The exact enclosing sphere (CGAL) last, and only where it can still be the least: its radius is at least
+    // half the widest extent, and a sphere's measure grows with its radius, so a sphere of that radius (shrunk by
+    // far more than the extents' rounding) that already measures `best` or more means the exact one does too, and
+    // the minimum is the same without it. Most sets of a robot's links are long, where the sphere loses by a
+    // factor; this skipped CGAL on most calls (docs/fitting.md, "Estimates without most exact spheres").
+    if (policy.is_allowed(BvType::sphere)) {
+        const double magnitude = std::max(world_box.min.cwiseAbs().maxCoeff(), world_box.max.cwiseAbs().maxCoeff());
+        const double least_radius = std::max(0.0, 0.5 * widest * (1.0 - 1e-9) - 0x1.0p-40 * magnitude);
+        if (policy.weight_of(BvType::sphere) * measure(Sphere{Vec3::Zero(), least_radius}) < best)
+            consider(BvType::sphere, measure(fit_sphere(spheres)));
     }
     return best;
 }
