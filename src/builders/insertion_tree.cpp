@@ -56,7 +56,8 @@ void InsertionTree::collect_primitives(std::uint32_t id, std::vector<std::uint32
 void InsertionTree::refit(std::uint32_t id) {
     std::vector<std::uint32_t> covered;
     collect_primitives(id, covered);
-    nodes_[id].volume = set_->fit(covered);
+    std::sort(covered.begin(), covered.end());
+    nodes_[id].volume = fits_->fit(*set_, std::move(covered));
     nodes_[id].weighted_volume = set_->weighted_volume(nodes_[id].volume);
 }
 

@@ -4,9 +4,11 @@
 
 #include <cstdint>
 #include <limits>
+#include <memory>
 #include <span>
 #include <vector>
 
+#include "covered_set_fits.hpp"
 #include "heuristic_support.hpp"
 #include "hbvh/tree/bvh.hpp"
 
@@ -84,6 +86,8 @@ private:
     void replace_child(std::uint32_t parent, std::uint32_t old_child, std::uint32_t new_child);
 
     const PrimitiveSet* set_;
+    /// Shared by the snapshots the builders take of the tree (a fit depends on its covered set alone).
+    std::shared_ptr<CoveredSetFits> fits_ = std::make_shared<CoveredSetFits>();
     std::vector<Node> nodes_;
     std::vector<std::uint32_t> free_;
     std::uint32_t root_ = no_node;

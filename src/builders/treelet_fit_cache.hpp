@@ -10,6 +10,7 @@
 
 #include "hbvh/builders/treelet.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
+#include "covered_set_fits.hpp"
 #include "treelet_bounds.hpp"
 
 namespace hbvh::detail {
@@ -18,18 +19,6 @@ namespace hbvh::detail {
 struct TreeletFit {
     BoundingVolume volume;
     double weighted = 0.0;
-};
-
-/// FNV-1a over the sorted primitive indices of a covered set.
-struct CoveredSetHash {
-    std::size_t operator()(const std::vector<std::uint32_t>& key) const {
-        std::uint64_t h = 1469598103934665603ull;
-        for (std::uint32_t v : key) {
-            h ^= v;
-            h *= 1099511628211ull;
-        }
-        return static_cast<std::size_t>(h);
-    }
 };
 
 /// Which fitter a refinement prices its subsets with.
