@@ -32,6 +32,17 @@ bool capsule_cannot_win(const detail::FitContext& context, std::span<const Mat3>
     return scale * detail::capsule_volume_lower_bound(context.proxy, planes, best_cost / scale) >= best_cost;
 }
 
+/// True when no sphere around a set as wide as `widest` along some axis can cost less than `best_cost`: its
+/// radius is at least half that width, and a sphere's measure grows with its radius. The boxes' widths carry their
+/// rounding pads, which grow with the coordinates' magnitude (`magnitude`, the largest of the boxes' corner
+/// coordinates): the floor's radius gives up far more than both, so that a skip never depends on them (for a
+/// lone point the pads are all the width there is).
+bool sphere_cannot_win(double widest, double magnitude, const VolumePolicy& policy, double best_cost) {
+    constexpr double rounding_margin = 1e-6;
+    const double least_radius = std::max(0.0, 0.5 * widest * (1.0 - rounding_margin) - 0x1.0p-40 * magnitude);
+    return policy.weighted_volume(Sphere{Vec3::Zero(), least_radius}) >= best_cost;
+}
+
 }  // namespace
 
 Aabb fit_aabb(std::span<const Sphere> spheres) {
@@ -100,12 +111,18 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
     // fitter needs the enclosing sphere: compute each once, and only when some allowed kind needs it.
     // The results are bit for bit those of the separate fitters.
     const bool wants_obb = policy.is_allowed(BvType::obb);
-    const bool wants_sphere = policy.is_allowed(BvType::sphere);
     const bool wants_capsule = policy.is_allowed(BvType::capsule);
     std::optional<detail::FitContext> context;
     if (wants_obb || wants_capsule) context = detail::make_fit_context(spheres, hint_axes);
+    // The exact enclosing sphere (CGAL) is made when first needed: by the sphere candidate, unless its floor says
+    // it cannot win, or by the capsule fitter, unless that is skipped.
     std::optional<Sphere> enclosing;
-    if (wants_sphere || wants_capsule) enclosing = fit_sphere(spheres);
+    const auto enclosing_sphere = [&]() -> const Sphere& {
+        if (!enclosing) enclosing = fit_sphere(spheres);
+        return *enclosing;
+    };
+    double widest = 0.0;     // the widest extent of the fitted boxes: the sphere is at least as wide
+    double magnitude = 0.0;  // and the largest coordinate they were rounded at
 
     std::optional<BoundingVolume> best;
     double best_cost = std::numeric_limits<double>::infinity();
@@ -118,17 +135,25 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
         if (type == BvType::capsule && best && policy.measure == NodeMeasure::volume &&
             capsule_cannot_win(*context, bound_planes, policy, best_cost))
             continue;
+        if (type == BvType::sphere && best && sphere_cannot_win(widest, magnitude, policy, best_cost)) continue;
         BoundingVolume candidate = [&]() -> BoundingVolume {
             switch (type) {
                 case BvType::aabb: return fit_aabb(spheres);
                 case BvType::obb: return detail::fit_obb_in(*context, spheres);
-                case BvType::sphere: return *enclosing;
-                case BvType::capsule: return detail::fit_capsule_in(*context, spheres, *enclosing);
+                case BvType::sphere: return enclosing_sphere();
+                case BvType::capsule: return detail::fit_capsule_in(*context, spheres, enclosing_sphere());
             }
             HBVH_ASSERT(false);
             return fit_aabb(spheres);
         }();
-        if (const Obb* box = std::get_if<Obb>(&candidate)) bound_planes.insert(bound_planes.begin(), box->rotation);
+        if (const Obb* box = std::get_if<Obb>(&candidate)) {
+            bound_planes.insert(bound_planes.begin(), box->rotation);
+            widest = std::max(widest, 2.0 * box->half_extents.maxCoeff());
+            magnitude = std::max(magnitude, box->center.cwiseAbs().maxCoeff() + box->half_extents.maxCoeff());
+        } else if (const Aabb* aabb = std::get_if<Aabb>(&candidate)) {
+            widest = std::max(widest, (aabb->max - aabb->min).maxCoeff());
+            magnitude = std::max({magnitude, aabb->min.cwiseAbs().maxCoeff(), aabb->max.cwiseAbs().maxCoeff()});
+        }
         const double candidate_cost = policy.weighted_volume(candidate);
         // Strict '<' keeps the earlier (simpler) kind on ties: AABB before OBB before sphere before capsule.
         if (!best || candidate_cost < best_cost) {
