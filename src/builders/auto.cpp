@@ -53,8 +53,8 @@ std::size_t members_to_refine(std::size_t primitive_count, std::size_t member_co
 /// Where only the `refined` cheapest unrefined trees are refined, which ones is known only when every member has
 /// built, yet some are certain sooner: a member is among them once enough finished members rank after it
 /// (costlier, or as costly and later in the list, as the final ranking breaks ties), since then no costs of the
-/// unfinished ones can push it out. Its refinement then starts at once instead of after the slowest build. Which
-/// trees are refined, and so every tree, stays the same; only when changes (docs/treelets.md §4).
+/// unfinished ones can push it out. Its refinement then starts at once instead of after the slowest build. The
+/// same trees are refined, so every tree is the same; only the refinements start sooner (docs/treelets.md §4).
 class EarlyRefinements {
 public:
     EarlyRefinements(std::size_t members, std::size_t refined)

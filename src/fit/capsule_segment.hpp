@@ -7,9 +7,9 @@
 #include <cmath>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include <Eigen/Core>
-#include <vector>
 
 namespace hbvh::detail {
 
