@@ -219,8 +219,8 @@ bool same_bits(const BoundingVolume& a, const BoundingVolume& b) {
 }
 
 TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
-    // Weights that make capsules cheap (rarely skipped) and dear (nearly always skipped), and policies
-    // without the OBB (the bound then has only the world axes to work with).
+    // Weights that make capsules cheap (rarely skipped) and dear (nearly always skipped), policies without the
+    // OBB (the bound then has only the world axes to work with), and the Minkowski measure.
     std::vector<VolumePolicy> policies{VolumePolicy::all()};
     VolumePolicy cheap_capsules;
     cheap_capsules.weight = {1.0, 1.0, 1.0, 0.3};
@@ -232,6 +232,11 @@ TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
     no_obb.allowed = {true, false, true, true};
     policies.push_back(no_obb);
     policies.push_back(VolumePolicy::only(BvType::capsule));
+    // The calibrated objective's measure, with spheres cheap: the sphere's floor is then priced by that measure.
+    VolumePolicy minkowski;
+    minkowski.measure = NodeMeasure::minkowski;
+    minkowski.weight = {1.0, 1.2, 0.6, 1.1};
+    policies.push_back(minkowski);
     int capsule_wins = 0;
     for (const SphereSet& set : all_sets())
         for (const VolumePolicy& policy : policies) {
