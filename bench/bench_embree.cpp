@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <new>
+#include <span>
 #include <string>
 #include <utility>
 #include <vector>
@@ -28,6 +29,7 @@
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
+#include "tree/collapse.hpp"
 
 namespace hbvh::bench {
 void fail(benchmark::State& state, const std::string& message);
@@ -113,6 +115,39 @@ Aabb measure(const RecordedNode* node, std::span<const Aabb> boxes, TreeMeasure&
     return box;
 }
 
+/// The recorded tree as a Bvh (breadth-first, as every Bvh is), each inner node the union of its children's
+/// boxes, so that hbvh's exact collapse can run on it.
+Bvh recorded_bvh(const RecordedNode* root, std::span<const Primitive> primitives, std::span<const Aabb> boxes) {
+    Bvh bvh;
+    bvh.primitives.assign(primitives.begin(), primitives.end());
+    std::vector<const RecordedNode*> order{root};
+    bvh.nodes.emplace_back();
+    for (std::size_t i = 0; i < order.size(); ++i) {
+        const RecordedNode* node = order[i];
+        if (node->is_leaf) {
+            bvh.nodes[i] = Node{boxes[node->primitive], 0, 0, node->primitive};
+            continue;
+        }
+        bvh.nodes[i].first_child = static_cast<std::uint32_t>(order.size());
+        bvh.nodes[i].child_count = node->child_count;
+        for (std::uint32_t c = 0; c < node->child_count && c < 2; ++c) {
+            order.push_back(node->children[c]);
+            bvh.nodes.emplace_back();
+        }
+    }
+    for (std::size_t i = bvh.nodes.size(); i-- > 0;) {
+        Node& node = bvh.nodes[i];
+        if (node.child_count == 0) continue;
+        Aabb box = Aabb::empty();
+        for (const Node& child : bvh.children(node)) box = box.merged(std::get<Aabb>(child.volume));
+        node.volume = box;
+    }
+    return bvh;
+}
+
+/// Collapsing Embree's tree takes a table of nodes x depth: done up to this size.
+constexpr std::uint32_t collapse_embree_max_primitives = 100'000;
+
 struct Row {
     std::string builder;
     double seconds = 0.0;
@@ -140,6 +175,8 @@ void embree_anchor(benchmark::State& state, std::uint32_t count, bool with_split
     // primitive array, which the builder uses as scratch space.
     const int repeats = count <= 100'000 ? 5 : 3;
     Row embree{"embree rtcBuildBVH", 0.0, 0.0};
+    const VolumePolicy aabb_only = parse_allowed_types("aabb").value();
+    double embree_collapsed_cost = 0.0;
     for (auto _ : state) {
         for (int r = 0; r < repeats; ++r) {
             std::vector<RTCBuildPrimitive> scratch = input;
@@ -170,6 +207,10 @@ void embree_anchor(benchmark::State& state, std::uint32_t count, bool with_split
             TreeMeasure tree;
             tree.seen.assign(primitives.size(), 0);
             measure(root, boxes, tree);
+            // Embree's binary tree with hbvh's exact collapse applied (wide nodes where they lower Eq. 2), untimed:
+            // how much of binned's lead is the collapse, and how much the cuts (docs/scale.md §9).
+            if (r == repeats - 1 && count <= collapse_embree_max_primitives && tree.extra_primitives == 0)
+                embree_collapsed_cost = cost(detail::collapse_optimally(recorded_bvh(root, primitives, boxes), aabb_only), aabb_only);
             rtcReleaseBVH(bvh);
             // A tree that lost or repeated a primitive would make its cost meaningless.
             if (tree.extra_primitives != 0 || tree.leaves != primitives.size() ||
@@ -184,6 +225,7 @@ void embree_anchor(benchmark::State& state, std::uint32_t count, bool with_split
     }
     rtcReleaseDevice(device);
     rows.push_back(embree);
+    if (embree_collapsed_cost > 0.0) rows.push_back({"embree rtcBuildBVH, collapsed by hbvh (untimed)", 0.0, embree_collapsed_cost});
 
     // hbvh, every inner node an AABB (`--types aabb`), once each: the builders take seconds to minutes here.
     BuildContext context;
@@ -210,15 +252,20 @@ void embree_anchor(benchmark::State& state, std::uint32_t count, bool with_split
 
     std::printf("\n%u primitives (hbvh generate --count %u --seed 1), AABB Eq. 2 cost\n", count, count);
     std::printf("| builder | build time (s) | cost | time / Embree | cost / Embree |\n|---|---|---|---|---|\n");
-    for (const Row& row : rows)
-        std::printf("| %s | %.4g | %.4g | %.1f | %.3f |\n", row.builder.c_str(), row.seconds, row.cost,
-                    row.seconds / embree.seconds, row.cost / embree.cost);
+    for (const Row& row : rows) {
+        if (row.seconds == 0.0)  // untimed
+            std::printf("| %s | - | %.4g | - | %.3f |\n", row.builder.c_str(), row.cost, row.cost / embree.cost);
+        else
+            std::printf("| %s | %.4g | %.4g | %.1f | %.3f |\n", row.builder.c_str(), row.seconds, row.cost,
+                        row.seconds / embree.seconds, row.cost / embree.cost);
+    }
     std::fflush(stdout);
     state.counters["primitives"] = count;
     state.counters["embree_seconds"] = embree.seconds;
     state.counters["embree_cost"] = embree.cost;
+    if (embree_collapsed_cost > 0.0) state.counters["embree_collapsed_cost_ratio"] = embree_collapsed_cost / embree.cost;
     for (const Row& row : rows) {
-        if (&row == &rows.front()) continue;  // Embree's own
+        if (row.builder.rfind("hbvh ", 0) != 0) continue;  // Embree's own rows
         const std::string builder = row.builder.substr(5, row.builder.find(' ', 5) - 5);  // "hbvh NAME --types aabb"
         state.counters[builder + "_seconds"] = row.seconds;
         state.counters[builder + "_cost_ratio"] = row.cost / embree.cost;
