@@ -168,8 +168,11 @@ HullSummary summary_by_qhull(std::span<const Vec3> points) {
     auto state = std::make_unique<qhT>();
     qhT* qh = state.get();
     qh_zero(qh, sink);
-    // 'Qt' triangulates merged facets so that every facet is a triangle for the area weighting.
-    char command[] = "qhull Qt";
+    // 'Qt' triangulates merged facets so that every facet is a triangle for the area weighting. 'Q5' skips
+    // qh_check_maxout, the pass over every point that finds the outer planes' offsets for qhull's own output and
+    // checks; the facets, their normals and vertices, which are all read here, do not depend on it. It was 6 % of
+    // qhull's time on the cannon, and the trees of 22 inputs came out byte for byte the same without it.
+    char command[] = "qhull Qt Q5";
     const int exit_code = qh_new_qhull(qh, 3, static_cast<int>(points.size()), coordinates.data(), False, command,
                                        nullptr, sink);
     if (exit_code == 0) {
