@@ -15,6 +15,7 @@
 #include "../memory/huge_pages.hpp"
 #include "../memory/thread_scratch.hpp"
 #include "../fit/sphere_extents.hpp"
+#include "../fit/sphere_floor.hpp"
 
 namespace hbvh::detail {
 namespace {
@@ -203,16 +204,13 @@ double estimate_weighted_volume(std::span<const Sphere> spheres, std::span<const
         }
     }
 
-    // The exact enclosing sphere (CGAL) last, and only where it can still be the least: its radius is at least
-    // half the widest extent, and a sphere's measure grows with its radius, so a sphere of that radius (shrunk by
-    // far more than the extents' rounding) that already measures `best` or more means the exact one does too, and
-    // the minimum is the same without it. Most sets of a robot's links are long, where the sphere loses by a
-    // factor; this skipped CGAL on most calls (docs/fitting.md, "Estimates without most exact spheres").
+    // The exact enclosing sphere (CGAL) last, and only where it can still be the least: where even the least
+    // sphere as wide as the set (least_sphere_cost) costs `best` or more, the exact one does too, and the minimum
+    // is the same without it. Most sets of a robot's links are long, where the sphere loses by a factor; this
+    // skipped CGAL on most calls (docs/fitting.md, "Estimates without most exact spheres").
     if (policy.is_allowed(BvType::sphere)) {
         const double magnitude = std::max(world_box.min.cwiseAbs().maxCoeff(), world_box.max.cwiseAbs().maxCoeff());
-        const double least_radius = std::max(0.0, 0.5 * widest * (1.0 - 1e-9) - 0x1.0p-40 * magnitude);
-        if (policy.weight_of(BvType::sphere) * measure(Sphere{Vec3::Zero(), least_radius}) < best)
-            consider(BvType::sphere, measure(fit_sphere(spheres)));
+        if (least_sphere_cost(widest, magnitude, policy) < best) consider(BvType::sphere, measure(fit_sphere(spheres)));
     }
     return best;
 }

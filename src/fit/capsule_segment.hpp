@@ -21,28 +21,14 @@ struct AxisDistances {
     std::vector<double> distance_squared;
 };
 
+// Defined here, inline: the radius search calls these ~500 times per capsule fit, most of them over the few
+// spheres of a golden-section bracket, where the call itself weighed (the cannon's build 1.6 % fewer instructions).
+
 /// The ends of the shortest segment on the axis line for capsule radius `radius`, before the fix-up for
 /// t1 < t0. Sphere i (distance d_i from the line) is inside iff its centre is within radius - r_i of the
 /// segment, i.e. the segment reaches within h_i = sqrt((radius - r_i)^2 - d_i^2) of t_i along the axis:
 /// t0 <= t_i + h_i and t1 >= t_i - h_i. So t0 = min(t_i + h_i), t1 = max(t_i - h_i).
-[[nodiscard]] inline std::pair<double, double> segment_ends(const AxisDistances& a, double radius);
-
-/// The shortest segment [t0, t1] for capsule radius `radius` (segment_ends); when t1 < t0 any single point
-/// of [t1, t0] works and the capsule is a sphere.
-[[nodiscard]] inline std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius);
-
-/// The spheres of `all` that can set an end of the segment for some radius in [low, high], into `kept`:
-/// for every radius in that range segment_for_radius gives bit for bit the same from `kept` as from `all`.
-/// h_i grows with the radius, and so does its computed value (every rounding step is monotone), so the
-/// sphere that sets t0 at a radius r has t_i + h_i(low) <= t_i + h_i(r) <= t_j + h_j(r) <= t_j + h_j(high)
-/// for every j: a sphere whose t_i + h_i(low) exceeds the smallest t_j + h_j(high) never sets t0 (t1 alike).
-/// The radius search evaluates ~25 radii in a bracket; near its ends few spheres compete (4 of 34 on average
-/// in FitSmall/capsule/16).
-void keep_end_candidates(const AxisDistances& all, double low, double high, AxisDistances& kept);
-
-// Inline: the radius search calls these ~500 times per capsule fit, most of them over the few spheres of a
-// golden-section bracket, where the call itself weighed (the cannon's build 1.6 % fewer instructions).
-inline std::pair<double, double> segment_ends(const AxisDistances& a, double radius) {
+[[nodiscard]] inline std::pair<double, double> segment_ends(const AxisDistances& a, double radius) {
     // Two spheres per step in SSE2 lanes (this loop is the capsule fitter's inner loop). min and max are
     // exact, so the lanes' order changes no result.
     using Pair = Eigen::Array2d;
@@ -70,10 +56,21 @@ inline std::pair<double, double> segment_ends(const AxisDistances& a, double rad
     return {t0, t1};
 }
 
-inline std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
+/// The shortest segment [t0, t1] for capsule radius `radius` (segment_ends); when t1 < t0 any single point
+/// of [t1, t0] works and the capsule is a sphere.
+[[nodiscard]] inline std::pair<double, double> segment_for_radius(const AxisDistances& a, double radius) {
     auto [t0, t1] = segment_ends(a, radius);
     if (t1 < t0) t0 = t1 = 0.5 * (t0 + t1);
     return {t0, t1};
 }
+
+/// The spheres of `all` that can set an end of the segment for some radius in [low, high], into `kept`:
+/// for every radius in that range segment_for_radius gives bit for bit the same from `kept` as from `all`.
+/// h_i grows with the radius, and so does its computed value (every rounding step is monotone), so the
+/// sphere that sets t0 at a radius r has t_i + h_i(low) <= t_i + h_i(r) <= t_j + h_j(r) <= t_j + h_j(high)
+/// for every j: a sphere whose t_i + h_i(low) exceeds the smallest t_j + h_j(high) never sets t0 (t1 alike).
+/// The radius search evaluates ~25 radii in a bracket; near its ends few spheres compete (4 of 34 on average
+/// in FitSmall/capsule/16).
+void keep_end_candidates(const AxisDistances& all, double low, double high, AxisDistances& kept);
 
 }  // namespace hbvh::detail

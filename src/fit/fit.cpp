@@ -14,6 +14,7 @@
 #include "capsule_bound.hpp"
 #include "fit_context.hpp"
 #include "rounding_pad.hpp"
+#include "sphere_floor.hpp"
 
 #include "hbvh/assert.hpp"
 
@@ -30,17 +31,6 @@ bool capsule_cannot_win(const detail::FitContext& context, std::span<const Mat3>
     constexpr double rounding_margin = 1e-6;
     const double scale = policy.weight_of(BvType::capsule) * (1.0 - rounding_margin);
     return scale * detail::capsule_volume_lower_bound(context.proxy, planes, best_cost / scale) >= best_cost;
-}
-
-/// True when no sphere around a set as wide as `widest` along some axis can cost less than `best_cost`: its
-/// radius is at least half that width, and a sphere's measure grows with its radius. The boxes' widths carry their
-/// rounding pads, which grow with the coordinates' magnitude (`magnitude`, the largest of the boxes' corner
-/// coordinates): the floor's radius gives up far more than both, so that a skip never depends on them (for a
-/// lone point the pads are all the width there is).
-bool sphere_cannot_win(double widest, double magnitude, const VolumePolicy& policy, double best_cost) {
-    constexpr double rounding_margin = 1e-6;
-    const double least_radius = std::max(0.0, 0.5 * widest * (1.0 - rounding_margin) - 0x1.0p-40 * magnitude);
-    return policy.weighted_volume(Sphere{Vec3::Zero(), least_radius}) >= best_cost;
 }
 
 }  // namespace
@@ -135,7 +125,7 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
         if (type == BvType::capsule && best && policy.measure == NodeMeasure::volume &&
             capsule_cannot_win(*context, bound_planes, policy, best_cost))
             continue;
-        if (type == BvType::sphere && best && sphere_cannot_win(widest, magnitude, policy, best_cost)) continue;
+        if (type == BvType::sphere && best && detail::least_sphere_cost(widest, magnitude, policy) >= best_cost) continue;
         BoundingVolume candidate = [&]() -> BoundingVolume {
             switch (type) {
                 case BvType::aabb: return fit_aabb(spheres);
