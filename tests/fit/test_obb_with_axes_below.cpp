@@ -5,7 +5,6 @@
 // placed just above, at and just below each true volume.
 #include <gtest/gtest.h>
 
-#include <cmath>
 #include <vector>
 
 #include "../../src/fit/frames.hpp"
@@ -14,16 +13,15 @@
 namespace hbvh {
 namespace {
 
+using test_support::random_placement;
 using test_support::random_spheres;
-using test_support::random_vector;
 
 TEST(ObbWithAxesBelow, ReturnsTheSameBoxOrOneNotBelowTheLimit) {
     SplitMix64 rng(17);
     int returned = 0;
     int dropped = 0;
     for (int trial = 0; trial < 2000; ++trial) {
-        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
-        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e4) * scale);
+        const auto [scale, offset] = random_placement(rng, 1e4);
         const auto count = 1 + rng.below(40);
         const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Mat3 rotation = rng.rotation();

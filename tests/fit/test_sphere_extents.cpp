@@ -16,14 +16,14 @@
 namespace hbvh {
 namespace {
 
+using test_support::random_placement;
 using test_support::random_spheres;
 using test_support::random_vector;
 
 TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) {
     SplitMix64 rng(41);
     for (int trial = 0; trial < 3000; ++trial) {
-        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
-        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
+        const auto [scale, offset] = random_placement(rng, 1e3);
         const auto count = rng.below(50);  // none too: empty extents
         const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         // A rotation, or any matrix (the fitters pass rotations; the loop must not assume one).
@@ -72,8 +72,7 @@ TEST(SphereExtents, MatchesAPlainLoopBitForBitAndTheExactExtentsWithinRounding) 
 TEST(SphereExtents, HalfExtentsFromACentreMatchAPlainLoopAndTheExactReach) {
     SplitMix64 rng(43);
     for (int trial = 0; trial < 3000; ++trial) {
-        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
-        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
+        const auto [scale, offset] = random_placement(rng, 1e3);
         const auto count = 1 + rng.below(50);
         const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Mat3 frame = rng.rotation();
@@ -114,8 +113,7 @@ TEST(SphereExtents, LineReachMatchesAPlainLoopAndTheExactDistances) {
     // with the documented scalar order bit for bit.
     SplitMix64 rng(47);
     for (int trial = 0; trial < 3000; ++trial) {
-        const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
-        const Vec3 offset = random_vector(rng, rng.uniform(0.0, 1e3) * scale);
+        const auto [scale, offset] = random_placement(rng, 1e3);
         const auto count = trial < 140 ? static_cast<std::uint64_t>(trial % 14) : rng.below(60);
         const std::vector<Sphere> spheres = random_spheres(rng, count, offset, scale);
         const Vec3 origin = offset + random_vector(rng, 0.2 * scale);

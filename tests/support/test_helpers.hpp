@@ -3,6 +3,7 @@
 // bottom-up level over primitives as they are (one node per primitive).
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -17,6 +18,17 @@ namespace hbvh::test_support {
 inline Vec3 random_vector(SplitMix64& rng, double half_width) {
     return {rng.uniform(-half_width, half_width), rng.uniform(-half_width, half_width),
             rng.uniform(-half_width, half_width)};
+}
+
+/// Where the fitters' loop tests put a random set: a size from 1e-3 to 1e3 and, in each coordinate, an offset from
+/// the origin of up to `reach` times that size, so that rounding far from the origin is exercised too.
+struct Placement {
+    double scale;
+    Vec3 offset;
+};
+inline Placement random_placement(SplitMix64& rng, double reach) {
+    const double scale = std::pow(10.0, rng.uniform(-3.0, 3.0));
+    return {scale, random_vector(rng, rng.uniform(0.0, reach) * scale)};
 }
 
 /// `count` spheres with centres in the cube of half-width `scale` around `offset`, about a third of them points
