@@ -117,7 +117,11 @@ private:
                 fresh[j].volume = std::move(bv);
             }
         };
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 4), fit_range);
+        // One fit_best per task: a fit takes 0.1-0.6 ms, and a DP round needs only a few, so with larger chunks an
+        // idle core (the last member refining, in auto) could not take any of them. The quick fitter's fits take
+        // microseconds, a task's own cost, so it keeps chunks of four.
+        const std::size_t grain = fitter_ == detail::TreeletFitter::best ? 1 : 4;
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), grain), fit_range);
         fits_ += masks.size();
         for (std::size_t j = 0; j < masks.size(); ++j) {
             // Another refinement sharing the cache may have inserted the same set meanwhile: its fit is identical
