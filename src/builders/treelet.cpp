@@ -26,6 +26,7 @@
 #include "treelet_fit_cache.hpp"
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/fit/fit_fast.hpp"
+#include "../fit/staged_fit.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh {
@@ -84,11 +85,20 @@ public:
     [[nodiscard]] std::uint64_t fit_count() const { return fits_; }
 
 private:
-    /// The volume over the primitives of one covered set, by the cache's fitter.
-    [[nodiscard]] BoundingVolume fit_set(std::span<const std::uint32_t> set) const {
+    /// The fit of one covered set by the cache's fitter; fit_best's may be short of its capsule step.
+    [[nodiscard]] Fitted fit_set(std::span<const std::uint32_t> set) const {
         FitInput input;
         for (std::uint32_t p : set) input.add(primitives_[p].volume);
-        if (fitter_ == detail::TreeletFitter::best) return fit_best(input.spheres, policy_, input.hint_axes);
+        if (fitter_ == detail::TreeletFitter::best) {
+            std::vector<Sphere> spheres = std::move(input.spheres);
+            if (spheres.size() > detail::repeats_checked_above)  // as fit_best does
+                if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
+                    spheres = std::move(distinct);
+            detail::FitStages stages = detail::start_fit(spheres, policy_, input.hint_axes);
+            // Without the bounds every set is fitted completely, as before the fits on demand (the tests' reference).
+            if (!bound_fits_) detail::finish_fit(stages, spheres, policy_);
+            return Fitted(std::move(stages), std::move(spheres), policy_);
+        }
         // fit_fast takes only a box hint's frame, so FitInput's distinct box frames stand in for the boxes; it
         // places a capsule along each capsule hint's line, so the distinct capsules go as they are.
         std::vector<BoundingVolume> hints;
@@ -102,7 +112,9 @@ private:
             });
             if (!repeat) hints.emplace_back(*capsule);
         }
-        return fit_fast(input.spheres, hints, policy_);
+        BoundingVolume bv = fit_fast(input.spheres, hints, policy_);
+        const double weighted = policy_.weighted_volume(bv);
+        return Fitted(std::move(bv), weighted);
     }
 
     /// Fits the sets of `masks` (keys[mask], sorted primitive indices) in parallel, each depending on its set
@@ -111,11 +123,7 @@ private:
                    std::vector<const Fitted*>& fitted) {
         std::vector<Fitted> fresh(masks.size());
         const auto fit_range = [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t j = range.begin(); j != range.end(); ++j) {
-                BoundingVolume bv = fit_set(keys[masks[j]]);
-                fresh[j].weighted = policy_.weighted_volume(bv);
-                fresh[j].volume = std::move(bv);
-            }
+            for (std::size_t j = range.begin(); j != range.end(); ++j) fresh[j] = fit_set(keys[masks[j]]);
         };
         // One fit_best per task: a fit takes 0.1-0.6 ms, and a DP round needs only a few, so with larger chunks an
         // idle core (the last member refining, in auto) could not take any of them. The quick fitter's fits take
@@ -129,6 +137,14 @@ private:
             const auto it = cache_.emplace(keys[masks[j]], std::move(fresh[j])).first;
             fitted[masks[j]] = &it->second;  // the map never moves its elements
         }
+    }
+
+    /// Runs the pending capsule steps of the fits of `masks`, in parallel.
+    void finish_masks(std::span<const std::uint32_t> masks, std::span<const Fitted* const> fitted) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, masks.size(), 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t j = range.begin(); j != range.end(); ++j) fitted[masks[j]]->finish();
+                          });
     }
 
     /// Sets known[mask] to the bound of the units in `mask` (sets keys[mask], or unit_primitives for one unit):
@@ -259,11 +275,16 @@ bool Refiner::refine_at(std::uint32_t root) {
     }
     std::vector<double> volume(subsets, 0.0);
     std::vector<std::uint32_t> keep(subsets, 0);  // item id + 1 whose BV to keep, 0 = use the fit
+    std::vector<std::uint8_t> settled(subsets, 0);  // volume[mask] is what the tree would pay, not a lower bound
     const auto settle = [&](std::uint32_t mask) {
-        volume[mask] = fitted[mask]->weighted;
+        // A fit short of its capsule step gives a lower bound; a kept volume at or below it is below the fit too.
+        const Fitted& fit = *fitted[mask];
+        volume[mask] = fit.value();
+        settled[mask] = fit.known();
         if (kept_volume[mask] <= volume[mask]) {
             volume[mask] = kept_volume[mask];
             keep[mask] = kept_id[mask];
+            settled[mask] = 1;
         }
     };
     for (std::uint32_t mask = 1; mask < subsets; ++mask)
@@ -300,16 +321,26 @@ bool Refiner::refine_at(std::uint32_t root) {
         fit_masks(missing, keys, fitted);
         for (std::uint32_t mask : missing) settle(mask);
     }
+    // The optimum over volumes that are lower bounds where not settled: it is the optimum over the fits once it
+    // uses settled volumes only. Until then its sets without a fit are fitted, and its fits short of the capsule
+    // step finished (each may then leave the optimum).
     OptimalPlan plan;
     for (;;) {
         plan = solve_optimal_hierarchy(units, volume);
         if (!(plan.cost < current * (1.0 - 1e-12))) return false;
         std::vector<std::uint32_t> needed;
-        for (const OptimalGroup& group : plan.groups)
-            if (fitted[group.covered] == nullptr) needed.push_back(group.covered);
-        if (needed.empty()) break;
+        std::vector<std::uint32_t> unfinished;
+        for (const OptimalGroup& group : plan.groups) {
+            if (fitted[group.covered] == nullptr)
+                needed.push_back(group.covered);
+            else if (!settled[group.covered])
+                unfinished.push_back(group.covered);
+        }
+        if (needed.empty() && unfinished.empty()) break;
         fit_masks(needed, keys, fitted);
+        finish_masks(unfinished, fitted);
         for (std::uint32_t mask : needed) settle(mask);
+        for (std::uint32_t mask : unfinished) settle(mask);
     }
 
     // Stage 5: rebuild the treelet, children before parents. The root keeps its id so that its parent
@@ -318,7 +349,7 @@ bool Refiner::refine_at(std::uint32_t root) {
     for (std::uint32_t i = 0; i < units; ++i) id_of[1u << i] = frontier[i];
     for (auto it = plan.groups.rbegin(); it != plan.groups.rend(); ++it) {
         const std::uint32_t mask = it->covered;
-        BoundingVolume bv = keep[mask] != 0 ? items_[keep[mask] - 1].volume : fitted[mask]->volume;
+        BoundingVolume bv = keep[mask] != 0 ? items_[keep[mask] - 1].volume : fitted[mask]->volume();
         std::vector<std::uint32_t> children;
         for (std::uint32_t child : it->children) children.push_back(id_of[child]);
         if (mask == subsets - 1u) {

@@ -3,22 +3,78 @@
 // primitives, so that auto's portfolio (one refinement per member) fits each covered set once.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
+#include <memory>
+#include <mutex>
 #include <vector>
 
 #include <tbb/concurrent_unordered_map.h>
 
 #include "hbvh/builders/treelet.hpp"
+#include "../fit/staged_fit.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
 #include "covered_set_fits.hpp"
 #include "treelet_bounds.hpp"
 
 namespace hbvh::detail {
 
-/// fit_best over one covered set and its weighted volume.
-struct TreeletFit {
-    BoundingVolume volume;
-    double weighted = 0.0;
+/// The fit of one covered set and its weighted volume, or fit_best's stages short of a capsule step that may
+/// still win (staged_fit.hpp): then only a lower bound is known until finish() runs that step. Most sets a
+/// treelet's DP fits only refute a cheaper arrangement, and the bound usually does that as well (docs/treelets.md,
+/// "The capsule on demand"). The answer is the same whichever thread finishes it, so sharing the fit is safe.
+class TreeletFit {
+public:
+    TreeletFit() = default;
+    /// A finished fit.
+    TreeletFit(BoundingVolume volume, double weighted) : volume_(std::move(volume)), weighted_(weighted) {}
+    /// fit_best's stages over `spheres` (its own copy of the set's spheres) under `policy`, which must outlive it.
+    TreeletFit(FitStages stages, std::vector<Sphere> spheres, const VolumePolicy& policy) {
+        if (!stages.capsule_pending) {
+            weighted_ = stages.best_cost;
+            volume_ = std::move(*stages.best);
+            return;
+        }
+        weighted_ = stages.lower_bound();
+        pending_ = std::make_unique<Pending>();
+        pending_->stages = std::move(stages);
+        pending_->spheres = std::move(spheres);
+        pending_->policy = &policy;
+    }
+
+    /// True when the answer is known: then value() is its weighted volume and volume() the volume.
+    [[nodiscard]] bool known() const { return !pending_ || pending_->done.load(std::memory_order_acquire); }
+    /// The answer's weighted volume when known(), else a lower bound of it.
+    [[nodiscard]] double value() const { return known() && pending_ ? pending_->weighted : weighted_; }
+    /// The answer. Precondition: known().
+    [[nodiscard]] const BoundingVolume& volume() const { return pending_ ? pending_->volume : volume_; }
+    /// Runs the pending step, once: a thread that asks meanwhile waits for it.
+    void finish() const {
+        if (!pending_) return;
+        Pending& pending = *pending_;
+        std::call_once(pending.once, [&] {
+            finish_fit(pending.stages, pending.spheres, *pending.policy);
+            pending.weighted = pending.stages.best_cost;
+            pending.volume = std::move(*pending.stages.best);
+            pending.stages = {};  // the context and the spheres are not needed any more
+            pending.spheres = {};
+            pending.done.store(true, std::memory_order_release);
+        });
+    }
+
+private:
+    struct Pending {
+        std::once_flag once;
+        std::atomic<bool> done{false};
+        FitStages stages;
+        std::vector<Sphere> spheres;
+        const VolumePolicy* policy = nullptr;
+        BoundingVolume volume;  // the answer, once done
+        double weighted = 0.0;
+    };
+    BoundingVolume volume_;  // the answer, when nothing was pending
+    double weighted_ = 0.0;  // its weighted volume, or the lower bound while pending
+    std::unique_ptr<Pending> pending_;
 };
 
 /// Which fitter a refinement prices its subsets with.

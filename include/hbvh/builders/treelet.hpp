@@ -20,8 +20,9 @@ struct TreeletOptions {
     /// Wall-clock limit in seconds (0 = none); checked between treelets, the tree so far is returned.
     double time_limit_seconds = 0.0;
     /// Fit a set only once the DP's optimum, with lower bounds (hull volumes) standing in for the sets not
-    /// fitted yet, uses it: the same optimum (docs/treelets.md, "Fits on demand") with 2-10x fewer fits. false:
-    /// fit every set of every treelet first, as before 2026-12-06 (for comparisons and tests).
+    /// fitted yet, uses it, and run a fit's capsule step only then too: the same optimum (docs/treelets.md, "Fits
+    /// on demand", "The capsule on demand") with 2-10x fewer fits. false: fit every set of every treelet first,
+    /// completely, as before 2026-12-06 (for comparisons and tests).
     bool bound_fits = true;
 };
 
