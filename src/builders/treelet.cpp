@@ -43,11 +43,17 @@ struct Item {
 
 using Fitted = detail::TreeletFit;
 
+/// What a fit waiting for its capsule step holds, roughly, for TreeletFitCache::pending_budget: its spheres twice
+/// (its own copy and the proxy's) and a few kilobytes of hull, frames and hints.
+constexpr std::size_t pending_bytes_per_sphere = 2 * sizeof(Sphere);
+constexpr std::size_t pending_bytes_each = 8192;
+
 class Refiner {
 public:
     Refiner(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options, detail::TreeletFitCache& cache)
         : primitives_(bvh.primitives), policy_(policy),
           max_units_(std::clamp<std::uint32_t>(options.max_units, 2, optimal_hard_limit)), cache_(cache.fits),
+          pending_budget_(cache.pending_budget),
           bounds_(cache.bounds), bound_scale_(detail::bound_scale(policy)), fitter_(cache.fitter()),
           bound_fits_(options.bound_fits && fitter_ == detail::TreeletFitter::best &&
                       (policy.is_allowed(BvType::obb) || policy.is_allowed(BvType::capsule))) {
@@ -95,9 +101,19 @@ private:
                 if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
                     spheres = std::move(distinct);
             detail::FitStages stages = detail::start_fit(spheres, policy_, input.hint_axes);
-            // Without the bounds every set is fitted completely, as before the fits on demand (the tests' reference).
-            if (!bound_fits_) detail::finish_fit(stages, spheres, policy_);
-            return Fitted(std::move(stages), std::move(spheres), policy_);
+            // Without the bounds every set is fitted completely, as before the fits on demand (the tests' reference);
+            // so is every set once the waiting fits hold their budget.
+            const auto charge = static_cast<std::int64_t>(pending_bytes_per_sphere * spheres.size() + pending_bytes_each);
+            bool wait = bound_fits_ && stages.capsule_pending;
+            if (wait && pending_budget_.fetch_sub(charge, std::memory_order_relaxed) < charge) {
+                pending_budget_.fetch_add(charge, std::memory_order_relaxed);
+                wait = false;
+            }
+            if (!wait) {
+                detail::finish_fit(stages, spheres, policy_);
+                return Fitted(std::move(*stages.best), stages.best_cost);
+            }
+            return Fitted(std::move(stages), std::move(spheres), policy_, pending_budget_, charge);
         }
         // fit_fast takes only a box hint's frame, so FitInput's distinct box frames stand in for the boxes; it
         // places a capsule along each capsule hint's line, so the distinct capsules go as they are.
@@ -191,6 +207,7 @@ private:
     std::uint32_t max_units_;
     std::vector<Item> items_;
     detail::TreeletFitCache::Map& cache_;
+    std::atomic<std::int64_t>& pending_budget_;
     detail::TreeletFitCache::BoundMap& bounds_;
     double bound_scale_;
     detail::TreeletFitter fitter_;
@@ -278,9 +295,11 @@ bool Refiner::refine_at(std::uint32_t root) {
     std::vector<std::uint8_t> settled(subsets, 0);  // volume[mask] is what the tree would pay, not a lower bound
     const auto settle = [&](std::uint32_t mask) {
         // A fit short of its capsule step gives a lower bound; a kept volume at or below it is below the fit too.
+        // known() first: another refinement may finish the fit meanwhile, and a value read after it is then the
+        // answer or still the bound, either of them at most the answer, while `settled` says only what was known.
         const Fitted& fit = *fitted[mask];
-        volume[mask] = fit.value();
         settled[mask] = fit.known();
+        volume[mask] = fit.value();
         if (kept_volume[mask] <= volume[mask]) {
             volume[mask] = kept_volume[mask];
             keep[mask] = kept_id[mask];

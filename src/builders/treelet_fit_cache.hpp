@@ -11,6 +11,7 @@
 
 #include <tbb/concurrent_unordered_map.h>
 
+#include "hbvh/assert.hpp"
 #include "hbvh/builders/treelet.hpp"
 #include "../fit/staged_fit.hpp"
 #include "hbvh/geometry/bounding_volume.hpp"
@@ -28,18 +29,25 @@ public:
     TreeletFit() = default;
     /// A finished fit.
     TreeletFit(BoundingVolume volume, double weighted) : volume_(std::move(volume)), weighted_(weighted) {}
-    /// fit_best's stages over `spheres` (its own copy of the set's spheres) under `policy`, which must outlive it.
-    TreeletFit(FitStages stages, std::vector<Sphere> spheres, const VolumePolicy& policy) {
-        if (!stages.capsule_pending) {
-            weighted_ = stages.best_cost;
-            volume_ = std::move(*stages.best);
-            return;
-        }
+    /// fit_best's stages, short of their capsule step, over `spheres` (its own copy of the set's spheres) under
+    /// `policy`, which must outlive it; the step holds `charge` of `budget` (TreeletFitCache::pending_budget),
+    /// taken by the caller, until it has run.
+    TreeletFit(FitStages stages, std::vector<Sphere> spheres, const VolumePolicy& policy,
+               std::atomic<std::int64_t>& budget, std::int64_t charge) {
+        HBVH_ASSERT(stages.capsule_pending);
         weighted_ = stages.lower_bound();
         pending_ = std::make_unique<Pending>();
         pending_->stages = std::move(stages);
         pending_->spheres = std::move(spheres);
         pending_->policy = &policy;
+        pending_->budget = &budget;
+        pending_->charge = charge;
+    }
+    TreeletFit(TreeletFit&&) noexcept = default;
+    TreeletFit& operator=(TreeletFit&&) noexcept = default;
+    ~TreeletFit() {
+        if (pending_ && !pending_->done.load(std::memory_order_acquire))
+            pending_->budget->fetch_add(pending_->charge, std::memory_order_relaxed);
     }
 
     /// True when the answer is known: then value() is its weighted volume and volume() the volume.
@@ -58,6 +66,7 @@ public:
             pending.volume = std::move(*pending.stages.best);
             pending.stages = {};  // the context and the spheres are not needed any more
             pending.spheres = {};
+            pending.budget->fetch_add(pending.charge, std::memory_order_relaxed);
             pending.done.store(true, std::memory_order_release);
         });
     }
@@ -69,6 +78,8 @@ private:
         FitStages stages;
         std::vector<Sphere> spheres;
         const VolumePolicy* policy = nullptr;
+        std::atomic<std::int64_t>* budget = nullptr;
+        std::int64_t charge = 0;
         BoundingVolume volume;  // the answer, once done
         double weighted = 0.0;
     };
@@ -102,6 +113,10 @@ public:
     /// the tree is the optimum over the fits whichever they are (docs/treelets.md, "Fits on demand").
     using BoundMap = tbb::concurrent_unordered_map<std::vector<std::uint32_t>, SetBound, CoveredSetHash>;
     BoundMap bounds;
+    /// Bytes, roughly, that fits waiting for their capsule step may hold at once (each its set's spheres and its
+    /// fit context): a refinement of a large tree would otherwise keep them for every set it fitted. Past it, a fit
+    /// runs its capsule step at once. Which fits wait changes no tree, only the work.
+    std::atomic<std::int64_t> pending_budget{std::int64_t{64} << 20};
 
 private:
     std::size_t primitive_count_;

@@ -125,6 +125,47 @@ TEST(Treelet, SameTreeForAnyThreadCount) {
     EXPECT_EQ(cost(one), cost(two));
 }
 
+// The capsule on demand (docs/treelets.md §4): a fit whose capsule step waits enters the DP at a lower bound and
+// is finished only when an optimum uses it. The trees must be node for node those of a cache with no room for a
+// waiting fit, whose fits all run their capsule step at once; the inputs mix boxes, spheres and capsules, where
+// capsules win some fits (the bundled models and generated scenes), under weights that make capsules cheap too.
+TEST(Treelet, CapsuleStepsOnDemandChangeNoTree) {
+    std::vector<std::pair<std::string, std::vector<Primitive>>> inputs;
+    for (std::uint64_t seed = 1; seed <= 2; ++seed)
+        inputs.emplace_back("generated " + std::to_string(seed), generated_scene(24, seed));
+    for (auto& [name, primitives] : test_support::bundled_models()) inputs.emplace_back(name, primitives);
+    VolumePolicy cheap_capsules = VolumePolicy::all();
+    cheap_capsules.weight = {1.0, 1.0, 1.0, 0.6};
+    const std::vector<VolumePolicy> policies{VolumePolicy::all(), cheap_capsules};
+    for (std::size_t k = 0; k < policies.size(); ++k) {
+        const VolumePolicy& policy = policies[k];
+        for (const auto& [name, primitives] : inputs) {
+            if (k > 0 && name.rfind("generated", 0) != 0) continue;  // the second weighting on generated scenes only
+            BuildContext context;
+            context.policy = policy;
+            Result<Bvh> input = build(primitives, Algorithm::insertion, context);
+            ASSERT_TRUE(input.has_value()) << name;
+            detail::TreeletFitCache waiting(primitives.size());
+            detail::TreeletFitCache never_waiting(primitives.size());
+            never_waiting.pending_budget = 0;
+            const Bvh on_demand = detail::refine_treelets_cached(*input, policy, {}, waiting);
+            const Bvh at_once = detail::refine_treelets_cached(*input, policy, {}, never_waiting);
+            ASSERT_EQ(on_demand.nodes.size(), at_once.nodes.size()) << name;
+            for (std::size_t i = 0; i < on_demand.nodes.size(); ++i) {
+                EXPECT_EQ(on_demand.nodes[i].first_child, at_once.nodes[i].first_child) << name << ", node " << i;
+                EXPECT_EQ(on_demand.nodes[i].child_count, at_once.nodes[i].child_count) << name << ", node " << i;
+                EXPECT_EQ(on_demand.nodes[i].primitive, at_once.nodes[i].primitive) << name << ", node " << i;
+                EXPECT_EQ(volume(on_demand.nodes[i].volume), volume(at_once.nodes[i].volume)) << name << ", node " << i;
+            }
+            // Some fits were still waiting at the end (the sets the DPs ruled out without their capsule), and every
+            // one gave its share back when dropped with the cache's entries.
+            EXPECT_LT(waiting.pending_budget.load(), std::int64_t{64} << 20) << name;
+            waiting.fits.clear();
+            EXPECT_EQ(waiting.pending_budget.load(), std::int64_t{64} << 20) << name;
+        }
+    }
+}
+
 // auto refines every member's tree with one fit cache. A cached fit must be exactly the fit a fresh
 // refinement would make: each member refined after the others through the shared cache gives the tree
 // it gives alone, and the later refinements find fits the earlier ones made.
