@@ -17,12 +17,14 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 
 #include "guarded_build.hpp"
 #include "set_partition.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/fit/fit_fast.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "../fit/staged_fit.hpp"
 
 namespace hbvh {
 namespace {
@@ -214,27 +216,69 @@ std::vector<std::vector<std::uint32_t>> window_member_sets(const LevelContext& l
     return sets;
 }
 
+/// A candidate's fit_best stopped short of a capsule step that could still win (src/fit/staged_fit.hpp), and the
+/// spheres to finish it on: its price is then a lower bound until the step runs.
+struct WaitingFit {
+    detail::FitStages stages;
+    std::vector<Sphere> spheres;
+};
+
+/// fit_group's pricing fit of a small group (fit_best), short of its capsule step where that could still win.
+BoundingVolume price_small_group(const LevelContext& level, std::span<const std::uint32_t> members,
+                                 std::optional<WaitingFit>& waiting, double& weighted) {
+    FitInput input = primitive_input(level, members);
+    std::vector<Sphere> spheres = std::move(input.spheres);
+    if (spheres.size() > detail::repeats_checked_above)  // as fit_best does
+        if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
+            spheres = std::move(distinct);
+    detail::FitStages stages = detail::start_fit(spheres, level.policy, input.hint_axes);
+    weighted = stages.lower_bound();
+    BoundingVolume best = *stages.best;
+    if (stages.capsule_pending) waiting = WaitingFit{std::move(stages), std::move(spheres)};
+    return best;
+}
+
 /// Solves one window [begin, end) of the level: candidates, prices, exact cover, fitted groups.
 WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::uint32_t end) {
     WindowResult result;
     std::vector<std::vector<std::uint32_t>> sets = window_member_sets(level, begin, end);
     std::vector<Candidate> candidates;
     std::vector<BoundingVolume> volumes;
+    // The capsule on demand, as in the treelets (docs/scale.md, "The capsule on demand"): a small group's price
+    // stops short of a capsule step that could still win, and the cover is solved with its lower bound; the
+    // step runs only for a chosen group, and the cover is solved again, until the chosen groups are all priced
+    // exactly. That cover is optimal over the exact prices too, so it is the one of pricing every group exactly.
+    std::vector<std::optional<WaitingFit>> waiting(sets.size());
     std::vector<std::uint32_t> global;
     candidates.reserve(sets.size());
-    for (auto& members : sets) {
+    for (std::size_t c = 0; c < sets.size(); ++c) {
+        std::vector<std::uint32_t>& members = sets[c];
         global.clear();
         std::uint32_t primitive_count = 0;
         for (std::uint32_t m : members) {
             global.push_back(begin + m);
             primitive_count += level.nodes[begin + m].primitive_count;
         }
-        BoundingVolume bv = fit_group(level, global, primitive_count, true);
-        const double cost = static_cast<double>(members.size()) * level.policy.weighted_volume(bv);
+        double weighted = 0.0;
+        BoundingVolume bv;
+        if (primitive_count <= level.exact_fit_max_primitives) {
+            bv = price_small_group(level, global, waiting[c], weighted);
+        } else {
+            bv = fit_group(level, global, primitive_count, true);
+            weighted = level.policy.weighted_volume(bv);
+        }
+        const double cost = static_cast<double>(members.size()) * weighted;
         candidates.push_back({std::move(members), cost});
         volumes.push_back(std::move(bv));
     }
     result.candidates = static_cast<std::uint32_t>(candidates.size());
+    const auto finish = [&](std::uint32_t c) {
+        WaitingFit& fit = *waiting[c];
+        detail::finish_fit(fit.stages, fit.spheres, level.policy);
+        candidates[c].cost = static_cast<double>(candidates[c].members.size()) * fit.stages.best_cost;
+        volumes[c] = std::move(*fit.stages.best);
+        waiting[c].reset();
+    };
 
     // Past the deadline, only the solver's initial cover (greedy + local search) is used.
     SolverBudget budget = level.options.window_budget;
@@ -242,11 +286,26 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
         budget.max_nodes = 1;
         result.budget_hit = true;
     }
-    const std::optional<Partition> partition = solve_exact(end - begin, candidates, budget);
+    std::optional<Partition> partition = solve_exact(end - begin, candidates, budget);
+    for (;;) {
+        result.solver_nodes += partition ? partition->nodes_explored : 0;
+        std::vector<std::uint32_t> unfinished;
+        if (partition && !partition->budget_hit) {
+            for (std::uint32_t c : partition->chosen)
+                if (waiting[c]) unfinished.push_back(c);
+        } else {
+            // No proof that the cover is optimal: price every candidate exactly and solve once more, as without
+            // the steps on demand.
+            for (std::uint32_t c = 0; c < waiting.size(); ++c)
+                if (waiting[c]) unfinished.push_back(c);
+        }
+        if (unfinished.empty()) break;
+        for (std::uint32_t c : unfinished) finish(c);
+        partition = solve_exact(end - begin, candidates, budget);
+    }
     std::vector<std::uint32_t> chosen;
     if (partition) {
         chosen = partition->chosen;
-        result.solver_nodes = partition->nodes_explored;
         result.budget_hit = result.budget_hit || partition->budget_hit;
     } else {
         // Only when the budget stopped the search before any cover: the consecutive fallback cover, whose
