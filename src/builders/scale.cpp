@@ -223,19 +223,24 @@ struct WaitingFit {
     std::vector<Sphere> spheres;
 };
 
-/// fit_group's pricing fit of a small group (fit_best), short of its capsule step where that could still win.
-BoundingVolume price_small_group(const LevelContext& level, std::span<const std::uint32_t> members,
-                                 std::optional<WaitingFit>& waiting, double& weighted) {
+/// fit_group's pricing fit of a small group (fit_best), short of its capsule step where that could still win:
+/// the volume found so far, its weighted volume (a lower bound of the answer while the step waits), the step.
+struct SmallGroupPrice {
+    BoundingVolume volume;
+    double weighted = 0.0;
+    std::optional<WaitingFit> waiting;
+};
+
+SmallGroupPrice price_small_group(const LevelContext& level, std::span<const std::uint32_t> members) {
     FitInput input = primitive_input(level, members);
     std::vector<Sphere> spheres = std::move(input.spheres);
     if (spheres.size() > detail::repeats_checked_above)  // as fit_best does
         if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
             spheres = std::move(distinct);
     detail::FitStages stages = detail::start_fit(spheres, level.policy, input.hint_axes);
-    weighted = stages.lower_bound();
-    BoundingVolume best = *stages.best;
-    if (stages.capsule_pending) waiting = WaitingFit{std::move(stages), std::move(spheres)};
-    return best;
+    SmallGroupPrice price{*stages.best, stages.lower_bound(), std::nullopt};
+    if (stages.capsule_pending) price.waiting = WaitingFit{std::move(stages), std::move(spheres)};
+    return price;
 }
 
 /// Solves one window [begin, end) of the level: candidates, prices, exact cover, fitted groups.
@@ -262,7 +267,10 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
         double weighted = 0.0;
         BoundingVolume bv;
         if (primitive_count <= level.exact_fit_max_primitives) {
-            bv = price_small_group(level, global, waiting[c], weighted);
+            SmallGroupPrice price = price_small_group(level, global);
+            bv = std::move(price.volume);
+            weighted = price.weighted;
+            waiting[c] = std::move(price.waiting);
         } else {
             bv = fit_group(level, global, primitive_count, true);
             weighted = level.policy.weighted_volume(bv);
@@ -274,7 +282,7 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
     result.candidates = static_cast<std::uint32_t>(candidates.size());
     const auto finish = [&](std::uint32_t c) {
         WaitingFit& fit = *waiting[c];
-        detail::finish_fit(fit.stages, fit.spheres, level.policy);
+        fit.stages.finish(fit.spheres, level.policy);
         candidates[c].cost = static_cast<double>(candidates[c].members.size()) * fit.stages.best_cost;
         volumes[c] = std::move(*fit.stages.best);
         waiting[c].reset();

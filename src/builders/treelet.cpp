@@ -110,7 +110,7 @@ private:
                 wait = false;
             }
             if (!wait) {
-                detail::finish_fit(stages, spheres, policy_);
+                stages.finish(spheres, policy_);
                 return Fitted(std::move(*stages.best), stages.best_cost);
             }
             return Fitted(std::move(stages), std::move(spheres), policy_, pending_budget_, charge);

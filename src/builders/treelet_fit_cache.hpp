@@ -61,7 +61,7 @@ public:
         if (!pending_) return;
         Pending& pending = *pending_;
         std::call_once(pending.once, [&] {
-            finish_fit(pending.stages, pending.spheres, *pending.policy);
+            pending.stages.finish(pending.spheres, *pending.policy);
             pending.weighted = pending.stages.best_cost;
             pending.volume = std::move(*pending.stages.best);
             pending.stages = {};  // the context and the spheres are not needed any more

@@ -57,7 +57,7 @@ BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& pol
     // Every step but the capsule's where it may still win, then that one: the staged form the treelet DP uses
     // (src/fit/staged_fit.hpp), run through here so that both give the same answer.
     detail::FitStages stages = detail::start_fit(spheres, policy, hint_axes);
-    detail::finish_fit(stages, spheres, policy);
+    stages.finish(spheres, policy);
     return *stages.best;
 }
 

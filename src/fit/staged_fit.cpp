@@ -110,10 +110,10 @@ FitStages start_fit(std::span<const Sphere> spheres, const VolumePolicy& policy,
     return stages;
 }
 
-void finish_fit(FitStages& stages, std::span<const Sphere> spheres, const VolumePolicy& policy) {
-    if (!stages.capsule_pending) return;
-    stages.capsule_pending = false;
-    consider(stages, fit_capsule_in(*stages.context, spheres, enclosing_sphere(stages, spheres)), policy);
+void FitStages::finish(std::span<const Sphere> spheres, const VolumePolicy& policy) {
+    if (!capsule_pending) return;
+    capsule_pending = false;
+    consider(*this, fit_capsule_in(*context, spheres, enclosing_sphere(*this, spheres)), policy);
 }
 
 }  // namespace hbvh::detail

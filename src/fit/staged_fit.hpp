@@ -28,7 +28,7 @@ inline constexpr std::size_t repeats_checked_above = 256;
 /// What fit_best has found before its capsule step. fit_best tries AABB, OBB, sphere and capsule in that order
 /// and keeps the first of the cheapest; the capsule step runs unless a lower bound of every capsule's volume
 /// already reaches the best price (capsule_bound.hpp). Where it would run, the first step stops short of it,
-/// with that bound recorded, and finish_fit() runs it: the answer is then fit_best's, bit for bit.
+/// with that bound recorded, and finish() runs it: the answer is then fit_best's, bit for bit.
 struct FitStages {
     std::optional<FitContext> context;
     std::optional<Sphere> enclosing;  ///< fit_sphere of the spheres, once made
@@ -43,15 +43,15 @@ struct FitStages {
 
     /// fit_best's weighted measure of its answer once nothing is pending, else a lower bound of it.
     [[nodiscard]] double lower_bound() const { return capsule_pending ? std::min(best_cost, capsule_floor) : best_cost; }
+
+    /// Runs the pending capsule step, if any, on the spheres and policy start_fit had; `best` is then fit_best's
+    /// answer.
+    void finish(std::span<const Sphere> spheres, const VolumePolicy& policy);
 };
 
 /// Every step of fit_best(spheres, policy, hint_axes) but a capsule step that could still win (after the repeats
 /// check: fit_best calls this with the spheres it fits).
 [[nodiscard]] FitStages start_fit(std::span<const Sphere> spheres, const VolumePolicy& policy,
                                   std::span<const Mat3> hint_axes);
-
-/// Runs the pending capsule step, if any, on the same spheres and policy; `stages.best` is then fit_best's
-/// answer.
-void finish_fit(FitStages& stages, std::span<const Sphere> spheres, const VolumePolicy& policy);
 
 }  // namespace hbvh::detail

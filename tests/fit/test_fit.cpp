@@ -269,7 +269,7 @@ TEST(Fit, AStagedFitsLowerBoundNeverExceedsItsAnswer) {
             const double before = stages.best_cost;
             const double bound = stages.lower_bound();
             EXPECT_LE(bound, before) << set.name;
-            detail::finish_fit(stages, set.spheres, policy);
+            stages.finish(set.spheres, policy);
             EXPECT_FALSE(stages.capsule_pending);
             EXPECT_LE(bound, stages.best_cost) << set.name;
             capsule_wins += type_of(*stages.best) == BvType::capsule ? 1 : 0;
