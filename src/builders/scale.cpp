@@ -287,6 +287,9 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
         volumes[c] = std::move(*fit.stages.best);
         waiting[c].reset();
     };
+    if (!level.options.capsule_on_demand)
+        for (std::uint32_t c = 0; c < waiting.size(); ++c)
+            if (waiting[c]) finish(c);
 
     // Past the deadline, only the solver's initial cover (greedy + local search) is used.
     SolverBudget budget = level.options.window_budget;

@@ -30,8 +30,8 @@ public:
     /// A finished fit.
     TreeletFit(BoundingVolume volume, double weighted) : volume_(std::move(volume)), weighted_(weighted) {}
     /// fit_best's stages, short of their capsule step, over `spheres` (its own copy of the set's spheres) under
-    /// `policy`, which must outlive it; the step holds `charge` of `budget` (TreeletFitCache::pending_budget),
-    /// taken by the caller, until it has run.
+    /// `policy` (copied: the refinement that made the fit may be over when another finishes it); the step holds
+    /// `charge` of `budget` (TreeletFitCache::pending_budget), taken by the caller, until it has run.
     TreeletFit(FitStages stages, std::vector<Sphere> spheres, const VolumePolicy& policy,
                std::atomic<std::int64_t>& budget, std::int64_t charge) {
         HBVH_ASSERT(stages.capsule_pending);
@@ -39,16 +39,21 @@ public:
         pending_ = std::make_unique<Pending>();
         pending_->stages = std::move(stages);
         pending_->spheres = std::move(spheres);
-        pending_->policy = &policy;
+        pending_->policy = policy;
         pending_->budget = &budget;
         pending_->charge = charge;
     }
     TreeletFit(TreeletFit&&) noexcept = default;
-    TreeletFit& operator=(TreeletFit&&) noexcept = default;
-    ~TreeletFit() {
-        if (pending_ && !pending_->done.load(std::memory_order_acquire))
-            pending_->budget->fetch_add(pending_->charge, std::memory_order_relaxed);
+    TreeletFit& operator=(TreeletFit&& other) noexcept {
+        if (this != &other) {
+            give_back();
+            volume_ = std::move(other.volume_);
+            weighted_ = other.weighted_;
+            pending_ = std::move(other.pending_);
+        }
+        return *this;
     }
+    ~TreeletFit() { give_back(); }
 
     /// True when the answer is known: then value() is its weighted volume and volume() the volume.
     [[nodiscard]] bool known() const { return !pending_ || pending_->done.load(std::memory_order_acquire); }
@@ -61,7 +66,7 @@ public:
         if (!pending_) return;
         Pending& pending = *pending_;
         std::call_once(pending.once, [&] {
-            pending.stages.finish(pending.spheres, *pending.policy);
+            pending.stages.finish(pending.spheres, pending.policy);
             pending.weighted = pending.stages.best_cost;
             pending.volume = std::move(*pending.stages.best);
             pending.stages = {};  // the context and the spheres are not needed any more
@@ -72,12 +77,18 @@ public:
     }
 
 private:
+    /// A step that never ran gives its share of the budget back when its fit goes.
+    void give_back() {
+        if (pending_ && !pending_->done.load(std::memory_order_acquire))
+            pending_->budget->fetch_add(pending_->charge, std::memory_order_relaxed);
+    }
+
     struct Pending {
         std::once_flag once;
         std::atomic<bool> done{false};
         FitStages stages;
         std::vector<Sphere> spheres;
-        const VolumePolicy* policy = nullptr;
+        VolumePolicy policy;
         std::atomic<std::int64_t>* budget = nullptr;
         std::int64_t charge = 0;
         BoundingVolume volume;  // the answer, once done

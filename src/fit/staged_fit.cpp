@@ -112,8 +112,8 @@ FitStages start_fit(std::span<const Sphere> spheres, const VolumePolicy& policy,
 
 void FitStages::finish(std::span<const Sphere> spheres, const VolumePolicy& policy) {
     if (!capsule_pending) return;
-    capsule_pending = false;
     consider(*this, fit_capsule_in(*context, spheres, enclosing_sphere(*this, spheres)), policy);
+    capsule_pending = false;  // only now: if the fitter threw, the step is still pending and a retry runs it
 }
 
 }  // namespace hbvh::detail

@@ -36,6 +36,11 @@ struct ScaleOptions {
     std::uint32_t exact_fit_level_max_input = 50'000;
     /// Per window solve_exact budget. A node limit, unlike a time limit, keeps the result deterministic.
     SolverBudget window_budget{20'000, 0.0};
+    /// Price a fit_best group without a capsule step that may still win, at a lower bound, and run that step
+    /// only for the groups a window's cover chooses, solving the window again until they are all priced
+    /// exactly (docs/scale.md §1, "The capsule on demand"): the same covers for less fitting. false: every
+    /// price exact before the first solve (for comparisons and tests).
+    bool capsule_on_demand = true;
 };
 
 /// The scale builder: level by level bottom-up. Each level is sorted along a Morton curve of the node
