@@ -219,16 +219,20 @@ bool same_bits(const BoundingVolume& a, const BoundingVolume& b) {
         a);
 }
 
-TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
-    // Weights that make capsules cheap (rarely skipped) and dear (nearly always skipped), policies without the
-    // OBB (the bound then has only the world axes to work with), and the Minkowski measure.
-    std::vector<VolumePolicy> policies{VolumePolicy::all()};
+/// Every kind at weight 1, and weights that make capsules cheap (their step rarely skipped) and dear (nearly always
+/// skipped).
+std::vector<VolumePolicy> capsule_weightings() {
     VolumePolicy cheap_capsules;
     cheap_capsules.weight = {1.0, 1.0, 1.0, 0.3};
-    policies.push_back(cheap_capsules);
     VolumePolicy dear_capsules;
     dear_capsules.weight = {1.0, 1.2, 1.0, 3.0};
-    policies.push_back(dear_capsules);
+    return {VolumePolicy::all(), cheap_capsules, dear_capsules};
+}
+
+TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
+    // The capsule weightings, policies without the OBB (the bound then has only the world axes to work with), and
+    // the Minkowski measure.
+    std::vector<VolumePolicy> policies = capsule_weightings();
     VolumePolicy no_obb;
     no_obb.allowed = {true, false, true, true};
     policies.push_back(no_obb);
@@ -251,13 +255,7 @@ TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
 TEST(Fit, AStagedFitsLowerBoundNeverExceedsItsAnswer) {
     // fit_best stopped before a capsule step that may still win (the treelet DP's partial fits) promises a lower
     // bound of the answer that step then gives; it must hold whether the capsule wins or not.
-    std::vector<VolumePolicy> policies{VolumePolicy::all()};
-    VolumePolicy cheap_capsules;
-    cheap_capsules.weight = {1.0, 1.0, 1.0, 0.3};
-    policies.push_back(cheap_capsules);
-    VolumePolicy dear_capsules;
-    dear_capsules.weight = {1.0, 1.2, 1.0, 3.0};
-    policies.push_back(dear_capsules);
+    const std::vector<VolumePolicy> policies = capsule_weightings();
     int pending = 0;
     int capsule_wins = 0;
     std::vector<double> ratios;
