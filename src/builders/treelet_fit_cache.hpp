@@ -127,7 +127,8 @@ public:
     /// Bytes, roughly, that fits waiting for their capsule step may hold at once (each its set's spheres and its
     /// fit context): a refinement of a large tree would otherwise keep them for every set it fitted. Past it, a fit
     /// runs its capsule step at once. Which fits wait changes no tree, only the work.
-    std::atomic<std::int64_t> pending_budget{std::int64_t{64} << 20};
+    static constexpr std::int64_t pending_budget_bytes = std::int64_t{32} << 20;
+    std::atomic<std::int64_t> pending_budget{pending_budget_bytes};
 
 private:
     std::size_t primitive_count_;

@@ -155,9 +155,9 @@ TEST(Treelet, CapsuleStepsOnDemandChangeNoTree) {
             test_support::expect_identical_trees(on_demand, at_once);
             // Some fits were still waiting at the end (the sets the DPs ruled out without their capsule), and every
             // one gave its share back when dropped with the cache's entries.
-            EXPECT_LT(waiting.pending_budget.load(), std::int64_t{64} << 20) << name;
+            EXPECT_LT(waiting.pending_budget.load(), detail::TreeletFitCache::pending_budget_bytes) << name;
             waiting.fits.clear();
-            EXPECT_EQ(waiting.pending_budget.load(), std::int64_t{64} << 20) << name;
+            EXPECT_EQ(waiting.pending_budget.load(), detail::TreeletFitCache::pending_budget_bytes) << name;
         }
     }
 }
