@@ -216,30 +216,19 @@ std::vector<std::vector<std::uint32_t>> window_member_sets(const LevelContext& l
     return sets;
 }
 
-/// A candidate's fit_best stopped short of a capsule step that could still win (src/fit/staged_fit.hpp), and the
-/// spheres to finish it on: its price is then a lower bound until the step runs.
-struct WaitingFit {
-    detail::FitStages stages;
-    std::vector<Sphere> spheres;
-};
-
 /// fit_group's pricing fit of a small group (fit_best), short of its capsule step where that could still win:
 /// the volume found so far, its weighted volume (a lower bound of the answer while the step waits), the step.
 struct SmallGroupPrice {
     BoundingVolume volume;
     double weighted = 0.0;
-    std::optional<WaitingFit> waiting;
+    std::optional<detail::OwnedFit> waiting;
 };
 
 SmallGroupPrice price_small_group(const LevelContext& level, std::span<const std::uint32_t> members) {
     FitInput input = primitive_input(level, members);
-    std::vector<Sphere> spheres = std::move(input.spheres);
-    if (spheres.size() > detail::repeats_checked_above)  // as fit_best does
-        if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
-            spheres = std::move(distinct);
-    detail::FitStages stages = detail::start_fit(spheres, level.policy, input.hint_axes);
-    SmallGroupPrice price{*stages.best, stages.lower_bound(), std::nullopt};
-    if (stages.capsule_pending) price.waiting = WaitingFit{std::move(stages), std::move(spheres)};
+    detail::OwnedFit fit = detail::start_owned_fit(std::move(input.spheres), level.policy, input.hint_axes);
+    SmallGroupPrice price{*fit.stages.best, fit.stages.lower_bound(), std::nullopt};
+    if (fit.stages.capsule_pending) price.waiting = std::move(fit);
     return price;
 }
 
@@ -253,7 +242,7 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
     // stops short of a capsule step that could still win, and the cover is solved with its lower bound; the
     // step runs only for a chosen group, and the cover is solved again, until the chosen groups are all priced
     // exactly. That cover is optimal over the exact prices too, so it is the one of pricing every group exactly.
-    std::vector<std::optional<WaitingFit>> waiting(sets.size());
+    std::vector<std::optional<detail::OwnedFit>> waiting(sets.size());
     std::vector<std::uint32_t> global;
     candidates.reserve(sets.size());
     for (std::size_t c = 0; c < sets.size(); ++c) {
@@ -281,8 +270,8 @@ WindowResult solve_window(const LevelContext& level, std::uint32_t begin, std::u
     }
     result.candidates = static_cast<std::uint32_t>(candidates.size());
     const auto finish = [&](std::uint32_t c) {
-        WaitingFit& fit = *waiting[c];
-        fit.stages.finish(fit.spheres, level.policy);
+        detail::OwnedFit& fit = *waiting[c];
+        fit.finish(level.policy);
         candidates[c].cost = static_cast<double>(candidates[c].members.size()) * fit.stages.best_cost;
         volumes[c] = std::move(*fit.stages.best);
         waiting[c].reset();

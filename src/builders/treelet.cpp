@@ -96,24 +96,21 @@ private:
         FitInput input;
         for (std::uint32_t p : set) input.add(primitives_[p].volume);
         if (fitter_ == detail::TreeletFitter::best) {
-            std::vector<Sphere> spheres = std::move(input.spheres);
-            if (spheres.size() > detail::repeats_checked_above)  // as fit_best does
-                if (std::vector<Sphere> distinct = detail::without_repeats(spheres); !distinct.empty())
-                    spheres = std::move(distinct);
-            detail::FitStages stages = detail::start_fit(spheres, policy_, input.hint_axes);
+            detail::OwnedFit fit = detail::start_owned_fit(std::move(input.spheres), policy_, input.hint_axes);
             // Without the bounds every set is fitted completely, as before the fits on demand (the tests' reference);
             // so is every set once the waiting fits hold their budget.
-            const auto charge = static_cast<std::int64_t>(pending_bytes_per_sphere * spheres.size() + pending_bytes_each);
-            bool wait = bound_fits_ && stages.capsule_pending;
+            const auto charge =
+                static_cast<std::int64_t>(pending_bytes_per_sphere * fit.spheres.size() + pending_bytes_each);
+            bool wait = bound_fits_ && fit.stages.capsule_pending;
             if (wait && pending_budget_.fetch_sub(charge, std::memory_order_relaxed) < charge) {
                 pending_budget_.fetch_add(charge, std::memory_order_relaxed);
                 wait = false;
             }
             if (!wait) {
-                stages.finish(spheres, policy_);
-                return Fitted(std::move(*stages.best), stages.best_cost);
+                fit.finish(policy_);
+                return Fitted(std::move(*fit.stages.best), fit.stages.best_cost);
             }
-            return Fitted(std::move(stages), std::move(spheres), policy_, pending_budget_, charge);
+            return Fitted(std::move(fit), policy_, pending_budget_, charge);
         }
         // fit_fast takes only a box hint's frame, so FitInput's distinct box frames stand in for the boxes; it
         // places a capsule along each capsule hint's line, so the distinct capsules go as they are.

@@ -29,16 +29,14 @@ public:
     TreeletFit() = default;
     /// A finished fit.
     TreeletFit(BoundingVolume volume, double weighted) : volume_(std::move(volume)), weighted_(weighted) {}
-    /// fit_best's stages, short of their capsule step, over `spheres` (its own copy of the set's spheres) under
-    /// `policy` (copied: the refinement that made the fit may be over when another finishes it); the step holds
-    /// `charge` of `budget` (TreeletFitCache::pending_budget), taken by the caller, until it has run.
-    TreeletFit(FitStages stages, std::vector<Sphere> spheres, const VolumePolicy& policy,
-               std::atomic<std::int64_t>& budget, std::int64_t charge) {
-        HBVH_ASSERT(stages.capsule_pending);
-        weighted_ = stages.lower_bound();
+    /// fit_best's stages, short of their capsule step, under `policy` (copied: the refinement that made the fit may
+    /// be over when another finishes it); the step holds `charge` of `budget` (TreeletFitCache::pending_budget),
+    /// taken by the caller, until it has run.
+    TreeletFit(OwnedFit fit, const VolumePolicy& policy, std::atomic<std::int64_t>& budget, std::int64_t charge) {
+        HBVH_ASSERT(fit.stages.capsule_pending);
+        weighted_ = fit.stages.lower_bound();
         pending_ = std::make_unique<Pending>();
-        pending_->stages = std::move(stages);
-        pending_->spheres = std::move(spheres);
+        pending_->fit = std::move(fit);
         pending_->policy = policy;
         pending_->budget = &budget;
         pending_->charge = charge;
@@ -66,11 +64,10 @@ public:
         if (!pending_) return;
         Pending& pending = *pending_;
         std::call_once(pending.once, [&] {
-            pending.stages.finish(pending.spheres, pending.policy);
-            pending.weighted = pending.stages.best_cost;
-            pending.volume = std::move(*pending.stages.best);
-            pending.stages = {};  // the context and the spheres are not needed any more
-            pending.spheres = {};
+            pending.fit.finish(pending.policy);
+            pending.weighted = pending.fit.stages.best_cost;
+            pending.volume = std::move(*pending.fit.stages.best);
+            pending.fit = {};  // the context and the spheres are not needed any more
             pending.budget->fetch_add(pending.charge, std::memory_order_relaxed);
             pending.done.store(true, std::memory_order_release);
         });
@@ -86,8 +83,7 @@ private:
     struct Pending {
         std::once_flag once;
         std::atomic<bool> done{false};
-        FitStages stages;
-        std::vector<Sphere> spheres;
+        OwnedFit fit;
         VolumePolicy policy;
         std::atomic<std::int64_t>* budget = nullptr;
         std::int64_t charge = 0;

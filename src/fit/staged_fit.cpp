@@ -110,6 +110,16 @@ FitStages start_fit(std::span<const Sphere> spheres, const VolumePolicy& policy,
     return stages;
 }
 
+OwnedFit start_owned_fit(std::vector<Sphere> spheres, const VolumePolicy& policy, std::span<const Mat3> hint_axes) {
+    OwnedFit fit;
+    fit.spheres = std::move(spheres);
+    if (fit.spheres.size() > repeats_checked_above)  // as fit_best does
+        if (std::vector<Sphere> distinct = without_repeats(fit.spheres); !distinct.empty())
+            fit.spheres = std::move(distinct);
+    fit.stages = start_fit(fit.spheres, policy, hint_axes);
+    return fit;
+}
+
 void FitStages::finish(std::span<const Sphere> spheres, const VolumePolicy& policy) {
     if (!capsule_pending) return;
     consider(*this, fit_capsule_in(*context, spheres, enclosing_sphere(*this, spheres)), policy);

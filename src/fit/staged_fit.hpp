@@ -54,4 +54,16 @@ struct FitStages {
 [[nodiscard]] FitStages start_fit(std::span<const Sphere> spheres, const VolumePolicy& policy,
                                   std::span<const Mat3> hint_axes);
 
+/// start_fit over spheres it keeps (those fit_best would fit: without exact repeats above repeats_checked_above),
+/// for a caller that may run the capsule step later, when the spheres it was given are gone.
+struct OwnedFit {
+    std::vector<Sphere> spheres;
+    FitStages stages;
+
+    /// Runs the pending capsule step, if any (FitStages::finish on the kept spheres).
+    void finish(const VolumePolicy& policy) { stages.finish(spheres, policy); }
+};
+[[nodiscard]] OwnedFit start_owned_fit(std::vector<Sphere> spheres, const VolumePolicy& policy,
+                                       std::span<const Mat3> hint_axes);
+
 }  // namespace hbvh::detail
