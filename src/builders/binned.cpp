@@ -187,7 +187,7 @@ private:
     [[nodiscard]] bool is_leaf_slot(std::uint32_t slot) const { return slot < refs_.size(); }
     [[nodiscard]] std::uint8_t* split_of(std::uint32_t slot) { return split_.data() + std::size_t{slot} * (max_children_ + 1); }
 
-    // ---- Step 1: the binary tree, top-down -------------------------------------------------------------
+    // Step 1: the binary tree, top-down.
 
     /// A planned subtree: its root's slot and collapse costs. The costs are needed only by the parent, so they
     /// travel up the recursion instead of living in an array over every node (144 MB at 10^6 primitives).
@@ -596,7 +596,7 @@ private:
         std::copy(sorted.begin(), sorted.end(), range.begin());
     }
 
-    // ---- Step 2: the collapse --------------------------------------------------------------------------
+    // Step 2: the collapse.
 
     // For each binary node v, best[k] (k = 1..max_children) is the least Eq. 2 cost below v's nearest kept
     // ancestor A that v's subtree adds when it makes k of A's children: k = 1 keeps v (its own volume once per
@@ -678,7 +678,7 @@ private:
         return sum;
     }
 
-    // ---- Step 3: one fit per kept node -----------------------------------------------------------------
+    // Step 3: one fit per kept node.
 
     /// Fits every kept node, children before parents (a node's hull fit uses its children's volumes), the
     /// subtrees of large nodes in parallel. Each volume depends on its subtree only, so on no thread count.
@@ -809,7 +809,7 @@ private:
         return best;
     }
 
-    // ---- Step 4: the hierarchy -------------------------------------------------------------------------
+    // Step 4: the hierarchy.
 
     /// `wide` (children before parents, the root last) as `bvh.nodes`, breadth-first (a node's children are
     /// contiguous). Leaves carry their primitive's own volume. First the places, in one serial pass over

@@ -19,7 +19,7 @@
 namespace hbvh {
 namespace {
 
-// ---- The libccd oracle --------------------------------------------------------------------------------
+// The libccd oracle.
 // libccd 2.0 has no GJK distance for disjoint bodies, and its ccdGJKIntersect proved self-inconsistent near
 // contact (with 1e-6 relative penetration it answered "disjoint" for bodies whose shrunk copies it called
 // "intersecting": hundreds per 100 000 configurations). Its MPR test (Snethen's XenoCollide) on the same
@@ -129,7 +129,7 @@ Verdict oracle(const BoundingVolume& a, const BoundingVolume& b, const Vec3& ori
     return shrunk ? Verdict::overlapping : Verdict::ambiguous;
 }
 
-// ---- Random configurations ----------------------------------------------------------------------------
+// Random configurations.
 
 double log_uniform(SplitMix64& rng, double lo, double hi) { return lo * std::pow(hi / lo, rng.uniform()); }
 
@@ -401,7 +401,7 @@ std::vector<OracleCase> oracle_cases() {
 
 INSTANTIATE_TEST_SUITE_P(AllPairs, OverlapOracle, ::testing::ValuesIn(oracle_cases()), case_name);
 
-// ---- Dense brute force for the distance kernels -------------------------------------------------------
+// Dense brute force for the distance kernels.
 
 /// Golden-section minimum of a convex function on [0, 1] (to ~1e-12 in t).
 template <class F>
@@ -462,7 +462,7 @@ TEST(SegmentSegmentDistance, MatchesGoldenSectionIncludingParallel) {
     EXPECT_EQ(mismatches, 0);
 }
 
-// ---- Hand-made touching, separated and nested cases ---------------------------------------------------
+// Hand-made touching, separated and nested cases.
 
 /// Unit cube [0, 1]^3 in each box form, and a sphere/capsule family that touches its x = 1 face.
 const Aabb unit_box{Vec3(0, 0, 0), Vec3(1, 1, 1)};
@@ -580,7 +580,7 @@ TEST(BoxesMayOverlap, NeverRejectsAnExactOverlapIncludingTouching) {
     EXPECT_TRUE(may_overlap(unit, unit, RigidTransform{Mat3::Identity(), Vec3(2.0, 0, 0)}));
 }
 
-// ---- Touching far from the origin ---------------------------------------------------------------------
+// Touching far from the origin.
 
 /// A rigid motion to `offset` in a random direction, randomly turned (or only translated, for Aabbs).
 RigidTransform far_motion(SplitMix64& rng, double offset, bool turn) {

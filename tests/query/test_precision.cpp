@@ -37,7 +37,7 @@ std::uint32_t primitive_count(Algorithm algorithm) {
 /// plus 1e-12 of the objects' size (overlaps() itself accepts gaps up to ~1e-13 of the coordinates).
 double precision_band(double coordinates, double size) { return 1e-12 * coordinates + 1e-12 * size; }
 
-// ---- Independent separation check (libccd MPR on grown and shrunk primitives) --------------------------
+// Independent separation check (libccd MPR on grown and shrunk primitives).
 
 /// A primitive grown (grow > 0: Minkowski sum with a ball) or shrunk (grow < 0: erosion by a ball, exact for
 /// boxes, spheres and capsules), seen from `origin` at zoom `unit` (libccd's tolerances are absolute).
@@ -122,7 +122,7 @@ bool within_band(const BoundingVolume& a, const BoundingVolume& b, double band) 
     return grown && !shrunk;
 }
 
-// ---- Scenes and motions ---------------------------------------------------------------------------------
+// Scenes and motions.
 
 /// The primitives moved by `m`; Aabbs stay Aabbs under a pure translation (else they become Obbs).
 std::vector<Primitive> moved(const std::vector<Primitive>& primitives, const RigidTransform& m) {
@@ -191,7 +191,7 @@ int expect_same_up_to_band(const Pairs& at_origin, const Pairs& moved_pairs, con
     return static_cast<int>(differing.size());
 }
 
-// ---- Metamorphic: the whole scene moved ----------------------------------------------------------------
+// Metamorphic: the whole scene moved.
 
 class PrecisionPerBuilder : public ::testing::TestWithParam<AlgorithmInfo> {};
 
@@ -251,7 +251,7 @@ INSTANTIATE_TEST_SUITE_P(EveryAlgorithm, PrecisionPerBuilder, ::testing::ValuesI
                              return name;
                          });
 
-// ---- Resting contacts far from the origin --------------------------------------------------------------
+// Resting contacts far from the origin.
 
 /// Two objects in one scene frame whose `contacts` pairs (a's primitive, b's primitive) rest on each other
 /// at a penetration of 1e-9 of the size; the rest of each object lies well away from the contact, so that
