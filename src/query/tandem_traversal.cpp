@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "pair_tests.hpp"
+#include "sort_pairs.hpp"
 #include "../simd/wide_clones.hpp"
 
 namespace hbvh {
@@ -221,7 +222,8 @@ HBVH_WIDE_CLONES_INLINED void collide(const QueryTree& a, const RigidTransform& 
     MovedLeaves& moved = detail::moved_leaves();
     moved.begin(b, t);
     Traversal(a, b, t, mode, flat_pair_limit, result, moved).run();
-    std::sort(result.pairs.begin(), result.pairs.end());
+    detail::sort_pairs(result.pairs, static_cast<std::uint32_t>(a.primitive_nodes().size()),
+                       static_cast<std::uint32_t>(b.primitive_nodes().size()));
 }
 
 CollideResult collide(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,

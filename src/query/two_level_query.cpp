@@ -1,9 +1,8 @@
 // SPDX-License-Identifier: MIT
 // The survey's Two-Level query (§6): the roots, then every primitive pair.
-#include <algorithm>
-
 #include "hbvh/query/tandem_traversal.hpp"
 #include "pair_tests.hpp"
+#include "sort_pairs.hpp"
 #include "../simd/wide_clones.hpp"
 
 namespace hbvh {
@@ -42,7 +41,8 @@ HBVH_WIDE_CLONES_INLINED void collide_two_level(const QueryTree& a, const RigidT
             if (mode == CollideMode::first) return;
         }
     }
-    std::sort(result.pairs.begin(), result.pairs.end());
+    detail::sort_pairs(result.pairs, static_cast<std::uint32_t>(a.primitive_nodes().size()),
+                       static_cast<std::uint32_t>(b.primitive_nodes().size()));
 }
 
 CollideResult collide_two_level(const QueryTree& a, const RigidTransform& pose_a, const QueryTree& b,
