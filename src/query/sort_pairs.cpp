@@ -38,7 +38,7 @@ void counting_pass(const std::vector<Pair>& from, std::vector<Pair>& to, std::ui
 
 }  // namespace pair_order
 
-void sort_pairs(std::vector<pair_order::Pair>& pairs, std::uint32_t first_count, std::uint32_t second_count) {
+void sort_many_pairs(std::vector<pair_order::Pair>& pairs, std::uint32_t first_count, std::uint32_t second_count) {
     using namespace pair_order;
     if (pairs.size() < key_min_pairs) {
         std::sort(pairs.begin(), pairs.end());
