@@ -230,13 +230,12 @@ def peers_summary(path):
     print('Query time ratios (peer / hbvh, above 1 = hbvh faster) per regime: ' + '; '.join(out) + '.')
     # The honest comparison: each peer at its fastest (FCL's traversal alone, without moving its objects;
     # Bullet with its compound algorithm found once and reused), and the worst row against the faster peer.
-    # The faster peer's ratio is the bench's own column, from unrounded times (the µs columns are rounded to
-    # 0.01, which moves a ratio of 0.2 µs rows by up to 5 %); FCL collide-only's has no column of its own.
+    # The ratios are the bench's own columns, from unrounded times (the µs columns are rounded to 0.01, which
+    # moves a ratio of 0.2 µs rows by up to 5 %); FCL collide-only's has no column of its own.
     honest = []
     for r in queries:
-        bullet, fcl_only, hbvh = number(r['bullet']), number(r['fcl collide only']), number(r['hbvh'])
-        faster = number(r['faster peer/hbvh']) if 'faster peer/hbvh' in r else min(bullet, fcl_only) / hbvh
-        honest.append((faster, number(r['bullet/hbvh']), fcl_only / hbvh, r))
+        fcl_only, hbvh = number(r['fcl collide only']), number(r['hbvh'])
+        honest.append((number(r['faster peer/hbvh']), number(r['bullet/hbvh']), fcl_only / hbvh, r))
     if honest:
         out = []
         for regime in dict.fromkeys(r['regime'] for r in queries):

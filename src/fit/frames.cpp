@@ -13,7 +13,6 @@
 
 #include "../memory/thread_scratch.hpp"
 #include "../simd/wide_clones.hpp"
-#include "hbvh/assert.hpp"
 #include "hull_2d.hpp"
 #include "rounding_pad.hpp"
 #include "sphere_extents.hpp"
@@ -377,7 +376,14 @@ namespace {
 constexpr double first_refine_step = 0.1;
 constexpr double least_refine_step = 2e-4;
 constexpr int max_refine_evaluations = 180;
-constexpr int refine_step_count = 9;  // 0.1 / 2^8 = 3.9e-4 is the last step above 2e-4
+
+/// How many steps, halving from `first`, stay above `least` (9 for 0.1 and 2e-4: the last is 3.9e-4).
+constexpr std::size_t halvings_above(double first, double least) {
+    std::size_t count = 0;
+    for (double step = first; step > least; step *= 0.5) ++count;
+    return count;
+}
+constexpr std::size_t refine_step_count = halvings_above(first_refine_step, least_refine_step);
 
 /// The search's rotations, about each axis by + and - each step: made once, the same matrices as made per
 /// candidate before (a sine and a cosine each, 2 % of an `auto` build's instructions).
@@ -392,7 +398,6 @@ struct RefineRotations {
                         Eigen::AngleAxisd((s == 0 ? 1.0 : -1.0) * step, Vec3::Unit(axis)).toRotationMatrix();
             step *= 0.5;
         }
-        HBVH_ASSERT(!(step > least_refine_step) && 2.0 * step > least_refine_step);
     }
 };
 
