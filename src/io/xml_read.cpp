@@ -315,13 +315,27 @@ Result<pugi::xml_node> Reader::parse_hierarchy() {
     const std::size_t root_end = text_.rfind("</hierarchy");
     if (const std::size_t nul = text_.find('\0', root_end == std::string::npos ? 0 : root_end); nul != std::string::npos)
         return error(line_at(static_cast<std::ptrdiff_t>(nul)), "a NUL byte: the file is binary or damaged");
-    if (const std::size_t last_tag = text_.rfind('>'); last_tag != std::string::npos &&
-                                                       !is_blank(std::string_view(text_).substr(last_tag + 1)))
-        return error(line_at(static_cast<std::ptrdiff_t>(last_tag + 1)),
-                     "text after the end of the document's last tag");
+    // Looked for before the parse, which writes into the text: text after the last '>' (reported after the parse,
+    // because a file cut short ends in such text too, and that is said better), and whether the root is closed.
+    const std::size_t last_tag = text_.rfind('>');
+    std::optional<std::size_t> trailing_text;
+    if (last_tag != std::string::npos && !is_blank(std::string_view(text_).substr(last_tag + 1)))
+        trailing_text = text_.find_first_not_of(" \t\r\n", last_tag + 1);
+    const bool root_open = text_.find("<hierarchy") != std::string::npos &&
+                           (root_end == std::string::npos || text_.find('>', root_end) == std::string::npos);
     const pugi::xml_parse_result parsed =
         doc_.load_buffer_inplace(text_.data(), text_.size(), pugi::parse_default, pugi::encoding_utf8);
-    if (!parsed) return error(line_at(parsed.offset), describe_parse_error(parsed));
+    if (!parsed) {
+        // The parser stops where its token began; one that began at or after the last '>' never closed, and with
+        // the root opened and not closed, the text ended inside an open tag or element: the file was cut short.
+        if (root_open && (last_tag == std::string::npos || parsed.offset >= static_cast<std::ptrdiff_t>(last_tag)))
+            return error(line_at(static_cast<std::ptrdiff_t>(text_.size()) - 1),
+                         "the file ends inside an unclosed tag or element: it is cut short (" +
+                             std::to_string(text_.size()) + " bytes)");
+        return error(line_at(parsed.offset), describe_parse_error(parsed));
+    }
+    if (trailing_text)
+        return error(line_at(static_cast<std::ptrdiff_t>(*trailing_text)), "text after the end of the document's last tag");
 
     pugi::xml_node hierarchy;
     for (const pugi::xml_node& node : doc_.children()) {
