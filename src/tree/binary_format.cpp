@@ -454,7 +454,7 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     if (size == 0) return fail(0, "file is empty");
     if (std::memcmp(data, binary_magic.data(), std::min(size, binary_magic.size())) != 0)
         return fail(0, "not an .hbvh file (wrong magic bytes)");
-    if (size < binary_header_size + binary_checksum_size)
+    if (size < binary_header_size)
         return fail(size, "file is truncated: it ends inside the " + std::to_string(binary_header_size) + "-byte header");
     BinaryReader header(data, size);
     header.skip(binary_magic.size());
@@ -471,6 +471,11 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     if (declared_size < size)
         return fail(declared_size, std::to_string(size - declared_size) + " bytes after the end of the file (" +
                                        std::to_string(declared_size) + " bytes, says the header)");
+    // A whole header, then fewer than the checksum's bytes, all of them declared: a header that is wrong.
+    if (size < binary_header_size + binary_checksum_size)
+        return fail(16, "the header says the file has " + std::to_string(declared_size) + " bytes, fewer than its " +
+                            std::to_string(binary_header_size) + "-byte header and " +
+                            std::to_string(binary_checksum_size) + "-byte checksum");
     const std::size_t checksum_at = size - binary_checksum_size;
     auto checksum_problem = [&]() -> std::string {
         const std::uint64_t stored = load_u64_le(data + checksum_at);
