@@ -357,6 +357,8 @@ Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& al
     BuildContext context;
     context.policy = policy.value();
     if (objective == "calibrated") context.policy.measure = NodeMeasure::minkowski;
+    BuildReport report;
+    context.report = &report;
     std::optional<Result<Bvh>> built;
     {
         py::gil_scoped_release unlocked;
@@ -364,6 +366,9 @@ Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& al
         built = refine ? build_refined(primitives.items, *chosen, timed) : build(primitives.items, *chosen, timed);
     }
     if (!*built) raise(built->error());
+    // As the CLI's warning: a tree of another builder than the one asked for is never silent.
+    if (!report.substitution.empty() && PyErr_WarnEx(PyExc_UserWarning, report.substitution.c_str(), 1) != 0)
+        throw py::error_already_set();  // the warning was turned into an error (warnings filter "error")
     return Hierarchy::from(std::move(built->value()));
 }
 

@@ -119,9 +119,10 @@ Result<Bvh> build_optimal(std::span<const Primitive> primitives, const BuildCont
         if (fallback && context.report != nullptr) {
             context.report->lower_bound = 0.0;
             context.report->built_by = "bnb-exact";
-            context.report->notes.push_back("optimal: " + std::to_string(primitives.size()) +
-                                            " primitives exceed the limit of " + std::to_string(limit) +
-                                            "; built bnb-exact instead (not proven optimal)");
+            context.report->substitution = "optimal: " + std::to_string(primitives.size()) +
+                                           " primitives exceed its limit of " + std::to_string(limit) +
+                                           "; built bnb-exact instead (not proven optimal)";
+            context.report->notes.push_back(context.report->substitution);
         }
         return fallback;
     }

@@ -195,6 +195,11 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
 
+# A builder that returns another's tree says so on stderr, whether or not --report or --stats is given: optimal
+# above its 18 primitives builds bnb-exact's tree.
+hbvh_cli_test(optimal_above_its_limit 0 "warning: optimal: 27 primitives exceed its limit of 18; built bnb-exact instead"
+              build ${PROJECT_SOURCE_DIR}/data/models/tie_interceptor.xml -a optimal -o ${HBVH_CLI_OUT}/optimal_27.xml)
+
 # --treelet-units reaches auto without --refine (its help says so; it once did only with --refine). On the cannon
 # three units keep insertion-haber's tree with one treelet replaced; the default seven end at scale's, 40.278.
 hbvh_cli_test(treelet_units.auto 0 "1 of 27 treelets replaced, [0-9]+ fits, cost 41.8691 -> 41.8559" build

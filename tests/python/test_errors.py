@@ -65,6 +65,17 @@ def test_bad_build_arguments_match_the_cli(cli):
         hbvh.build(chair, time_limit=-1.0)
 
 
+def test_a_substituted_builder_warns_as_the_cli_does(cli):
+    tie = hbvh.load(str(MODELS / "tie_interceptor.xml"))
+    with pytest.warns(UserWarning) as caught:
+        tree = hbvh.build(tie, algorithm="optimal")
+    result = run_cli(cli, "build", MODELS / "tie_interceptor.xml", "-a", "optimal", "-o", "-")
+    assert result.returncode == 0, result.stderr
+    assert [str(w.message) for w in caught] == [result.stderr.strip()[len("hbvh: warning: "):]]
+    assert "27 primitives exceed its limit of 18" in str(caught[0].message)
+    assert tree.cost > 0
+
+
 @pytest.mark.parametrize("content", [
     "<hierarchy><volume type='sphere' pos='0 0 0' radius='-1'/></hierarchy>",  # negative radius
     "<hierarchy><volume type='sphere' pos='0 nan 0' radius='1'/></hierarchy>",  # NaN

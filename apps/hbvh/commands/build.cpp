@@ -93,6 +93,7 @@ int run_build(const BuildArguments& args) {
     if (bar_drawn) fmt::print(stderr, "\n");
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!bvh) return report_error(bvh.error());
+    if (!report.substitution.empty()) report_warnings({report.substitution});
     if (args.report || args.stats) {
         const Stats stats = compute_stats(bvh.value(), policy);
         if (args.report) print_report(report, seconds, stats.cost);

@@ -28,6 +28,9 @@ struct BuildReport {
     /// The registry name of the builder whose tree was returned when it is not the one asked for (`optimal`
     /// above its primitive limit returns bnb-exact's); empty otherwise.
     std::string built_by;
+    /// Why, when built_by is set: one sentence the CLI prints as a warning and Python raises as a UserWarning, so
+    /// that a substituted tree is never silent (it is among the notes too).
+    std::string substitution;
 };
 
 }  // namespace hbvh
