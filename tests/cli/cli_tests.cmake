@@ -195,6 +195,15 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
 
+# compare names its builders with -a (one or a list, as --algorithms); --quality is no option of it, and --json and
+# --markdown exclude each other (each was accepted and ignored until 2026-12-07).
+hbvh_cli_test(compare.algorithm_flag 0 "chair \\(13 primitives\\)" compare ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              -a split,fast --markdown)
+hbvh_cli_test(compare.no_quality 2 "not expected: --quality" compare ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              --quality fast)
+hbvh_cli_test(compare.json_excludes_markdown 2 "--json excludes --markdown" compare
+              ${PROJECT_SOURCE_DIR}/data/models/chair.xml --json --markdown)
+
 # A builder that returns another's tree says so on stderr, whether or not --report or --stats is given: optimal
 # above its 18 primitives builds bnb-exact's tree.
 hbvh_cli_test(optimal_above_its_limit 0 "warning: optimal: 27 primitives exceed its limit of 18; built bnb-exact instead"

@@ -81,7 +81,8 @@ struct BuilderFlags {
     bool refine = false;              ///< --refine: treelet refinement after any builder.
     std::uint32_t treelet_units = TreeletOptions{}.max_units;  ///< --treelet-units.
     bool refit = false;  ///< --refit: a stored hierarchy's non-enclosing volumes are refitted instead of refused.
-    void add_to(CLI::App& command);
+    /// Adds the flags; without -a and --quality where the command picks its builders itself (compare's list).
+    void add_to(CLI::App& command, bool choose_builder = true);
     /// Adds --refit, for the commands that query or draw a stored hierarchy.
     void add_refit_to(CLI::App& command);
     /// The build these flags ask for, or a usage Error.

@@ -84,15 +84,17 @@ void report_warnings(const std::vector<std::string>& warnings) {
     for (const std::string& warning : warnings) fmt::print(stderr, "hbvh: warning: {}\n", warning);
 }
 
-void BuilderFlags::add_to(CLI::App& command) {
-    CLI::Option* algorithm_option =
-        command.add_option("-a,--algorithm", algorithm, "Construction algorithm (see `hbvh algorithms`)")
-            ->capture_default_str();
-    command.add_option("--quality", quality,
-                       "Preset instead of -a: fast (builds in about a millisecond for dozens of primitives, trees "
-                       "that cost more) or auto (the default: the cheapest trees, in 0.02-0.5 s for up to a few hundred primitives)")
-        ->check(CLI::IsMember({"fast", "auto"}))
-        ->excludes(algorithm_option);
+void BuilderFlags::add_to(CLI::App& command, bool choose_builder) {
+    if (choose_builder) {
+        CLI::Option* algorithm_option =
+            command.add_option("-a,--algorithm", algorithm, "Construction algorithm (see `hbvh algorithms`)")
+                ->capture_default_str();
+        command.add_option("--quality", quality,
+                           "Preset instead of -a: fast (builds in about a millisecond for dozens of primitives, trees "
+                           "that cost more) or auto (the default: the cheapest trees, in 0.02-0.5 s for up to a few hundred primitives)")
+            ->check(CLI::IsMember({"fast", "auto"}))
+            ->excludes(algorithm_option);
+    }
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
                        "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each), or @FILE as `hbvh calibrate` writes");

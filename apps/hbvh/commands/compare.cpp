@@ -240,7 +240,10 @@ void add_compare_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<CompareArguments>();
     CLI::App* sub = app.add_subcommand("compare", "Run builders on models and tabulate time and cost (survey Tables 2-3)");
     sub->add_option("files", args->inputs, "Primitive files")->required();
-    sub->add_option("--algorithms", args->algorithm_list, "Comma-separated builders (default: all registered)");
+    // -a names the builders here too (one or a list), as it names the one builder of the other commands; a
+    // --quality preset is a builder's name (`-a fast`), so compare has no --quality.
+    sub->add_option("-a,--algorithm,--algorithms", args->algorithm_list,
+                    "Comma-separated builders (default: all registered)");
     sub->add_option("--repeat", args->repeats, "Builds per row; the median time is reported")
         ->capture_default_str()
         ->check(CLI::Range(1, 1000));
@@ -249,9 +252,9 @@ void add_compare_command(CLI::App& app, Command& command) {
         ->capture_default_str();
     sub->add_option("--bnb-nodes", args->bnb_nodes,
                     "Search-node budget per solver call of the survey's branch and bound (0 = library default)");
-    args->builder.add_to(*sub);
-    sub->add_flag("--json", args->json, "Print JSON");
-    sub->add_flag("--markdown", args->markdown, "Print a Markdown table");
+    args->builder.add_to(*sub, /*choose_builder=*/false);
+    CLI::Option* json = sub->add_flag("--json", args->json, "Print JSON");
+    sub->add_flag("--markdown", args->markdown, "Print a Markdown table")->excludes(json);
     sub->footer(
         "Gap to optimum: cost / optimum - 1 (JSON: gap_to_optimum, a fraction, null when unknown), where the\n"
         "optimum is the optimal builder's proven Eq. 2 minimum; computed for models of at most\n"
