@@ -145,6 +145,9 @@ namespace {
 
 /// Replaces the regular file at `path` (or creates it) through a temporary file and rename; errors name `name`.
 Status replace_file(const std::filesystem::path& path, std::string_view content, const std::string& name) {
+    // A directory cannot be replaced by a file; rename() would say so as EISDIR, or as EBUSY for "." and "..".
+    if (struct stat target {}; ::stat(path.c_str(), &target) == 0 && S_ISDIR(target.st_mode))
+        return Error("is a directory, not a file: give the output a file name", name);
     // Stage 1: create a fresh temporary file next to the target. Same directory means same file system,
     // which rename() needs to be atomic. O_EXCL guarantees we never write into someone else's file.
     std::filesystem::path temporary;

@@ -72,15 +72,26 @@ TEST_F(FileTest, EmptyContentMakesAnEmptyFile) {
 }
 
 TEST_F(FileTest, FailureLeavesNothingBehind) {
-    // The target is a directory: rename() refuses, and the temporary file must be gone again.
+    // The target is a directory: refused by name, and neither a temporary file nor anything in it is left.
     const fs::path target = directory_ / "taken";
     fs::create_directory(target);
     const Status status = write_file_atomic(target, "content");
     ASSERT_FALSE(status);
     EXPECT_EQ(status.error().file, target.string());
-    EXPECT_NE(status.error().message.find("cannot replace"), std::string::npos) << status.error().to_string();
+    EXPECT_EQ(status.error().message, "is a directory, not a file: give the output a file name");
     EXPECT_EQ(entries(), std::vector<std::string>{"taken"});
     EXPECT_TRUE(fs::is_empty(target));
+}
+
+TEST_F(FileTest, DotAndDotDotAreRefusedAsDirectories) {
+    // rename() onto "." or ".." fails with EBUSY ("Device or resource busy"), which told a user nothing.
+    for (const char* name : {".", ".."}) {
+        const fs::path target = directory_ / name;
+        const Status status = write_file_atomic(target, "content");
+        ASSERT_FALSE(status) << name;
+        EXPECT_EQ(status.error().message, "is a directory, not a file: give the output a file name");
+    }
+    EXPECT_TRUE(entries().empty());
 }
 
 TEST_F(FileTest, MissingDirectoryIsAnError) {

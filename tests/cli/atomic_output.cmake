@@ -50,7 +50,7 @@ function(check_command name extension)
   endif()
   expect_no_temporaries(${dir})
 
-  # The output path is a directory: the rename fails after the temporary was written.
+  # The output path is a directory: refused before anything is written.
   file(MAKE_DIRECTORY ${dir}/taken.${extension})
   string(REPLACE "INPUT" "${good}" taken_args "${ARGN}")
   string(REPLACE "OUTPUT" "${dir}/taken.${extension}" taken_args "${taken_args}")
