@@ -85,6 +85,7 @@ hbvh_cli_test(directory_input 1 "a_directory.xml: is a directory, not a file" bu
               -o ${HBVH_CLI_OUT}/directory.out.xml)
 hbvh_cli_test(time_limit_nan 2 "'nan' is not a number of seconds >= 0" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               --time-limit nan -o ${HBVH_CLI_OUT}/x.xml)
+hbvh_cli_test(count_not_a_number 2 "--count: 'abc' is not a whole number from 1 to 100000000" generate --count abc)
 hbvh_cli_test(seed_negative 2 "'-1' is not a whole number" generate --count 2 --seed -1)
 hbvh_cli_test(seed_too_large 2 "'18446744073709551616' is not a whole number" generate --count 2
               --seed 18446744073709551616)
@@ -194,6 +195,10 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
               -a split -o ${HBVH_CLI_OUT}/quality_excludes.xml)
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
+
+# view writes HTML: an output named for another format is a usage error, before anything is built or written.
+hbvh_cli_test(view.not_html 2 "is not named .html" view ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              -o ${HBVH_CLI_OUT}/view.gltf)
 
 # compare names its builders with -a (one or a list, as --algorithms); --quality is no option of it, and --json and
 # --markdown exclude each other (each was accepted and ignored until 2026-12-07).

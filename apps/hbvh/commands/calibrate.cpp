@@ -142,13 +142,13 @@ void add_calibrate_command(CLI::App& app, Command& command) {
         "Measure the tandem traversal's inner-node test cost per pair of BV kinds; write per-kind weights");
     sub->add_option("--primitives", args->primitives, "Primitives in the generated scene")
         ->capture_default_str()
-        ->check(CLI::Range(20u, 100000u));
+        ->check(whole_number(20, 100000));
     sub->add_option("--queries", args->queries, "Recorded simulator queries each tree answers")
         ->capture_default_str()
-        ->check(CLI::Range(10u, 100000u));
+        ->check(whole_number(10, 100000));
     sub->add_option("--passes", args->passes, "Timed passes over the queries; the fastest counts")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(whole_number(1, 1000));
     sub->add_option("-o,--output", args->output, "Write the weights (type=weight,...) to this file");
     sub->footer("Example: hbvh calibrate -o weights.txt && hbvh build model.xml --type-weight @weights.txt");
     sub->callback([&command, args] { command = [args] { return run_calibrate(*args); }; });

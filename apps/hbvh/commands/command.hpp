@@ -52,6 +52,9 @@ int report_error(const Error& error);
 void report_warnings(const std::vector<std::string>& warnings);
 /// Refuses what is not a decimal integer from 0 to 2^64 - 1 (CLI11 alone wraps "-1" and clamps larger values, so
 /// different seeds on the command line gave the same scene).
+/// Accepts a whole number from `least` to `most` and names both in its refusal ("'abc' is not a whole number from 1
+/// to 1000"), where CLI::Range says "not in range" of a word that is no number at all.
+[[nodiscard]] CLI::Validator whole_number(std::uint64_t least, std::uint64_t most);
 [[nodiscard]] CLI::Validator seed_validator();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <iostream>
 #include <iterator>
+#include <limits>
 #include <system_error>
 
 #include "commands/command.hpp"
@@ -63,17 +64,20 @@ Status write_output(const std::string& path, const std::string& content) {
     return write_file_atomic(path, content);
 }
 
-CLI::Validator seed_validator() {
+CLI::Validator whole_number(std::uint64_t least, std::uint64_t most) {
     return CLI::Validator(
-        [](const std::string& text) {
+        [least, most](const std::string& text) {
             std::uint64_t value = 0;
             const auto [end, code] = std::from_chars(text.data(), text.data() + text.size(), value);
-            return code == std::errc{} && end == text.data() + text.size()
+            return code == std::errc{} && end == text.data() + text.size() && value >= least && value <= most
                        ? std::string()
-                       : "'" + text + "' is not a whole number from 0 to 18446744073709551615";
+                       : "'" + text + "' is not a whole number from " + std::to_string(least) + " to " +
+                             std::to_string(most);
         },
-        "SEED");
+        "[" + std::to_string(least) + " - " + std::to_string(most) + "]");
 }
+
+CLI::Validator seed_validator() { return whole_number(0, std::numeric_limits<std::uint64_t>::max()); }
 
 int report_error(const Error& error) {
     fmt::print(stderr, "hbvh: {}\n", error.to_string());
@@ -118,7 +122,7 @@ void BuilderFlags::add_to(CLI::App& command, bool choose_builder) {
     command.add_option("--treelet-units", treelet_units,
                        "Subtrees per treelet for --refine and auto (2^m fits each)")
         ->capture_default_str()
-        ->check(CLI::Range(3u, 12u));
+        ->check(whole_number(3, 12));
 }
 
 Result<BuildRequest> BuilderFlags::resolve() const {

@@ -246,7 +246,7 @@ void add_compare_command(CLI::App& app, Command& command) {
                     "Comma-separated builders (default: all registered)");
     sub->add_option("--repeat", args->repeats, "Builds per row; the median time is reported")
         ->capture_default_str()
-        ->check(CLI::Range(1, 1000));
+        ->check(whole_number(1, 1000));
     sub->add_option("--optimum-max-primitives", args->optimum_max_primitives,
                     "Compute the optimum (gap column) for models up to this size; at most the optimal builder's limit")
         ->capture_default_str();

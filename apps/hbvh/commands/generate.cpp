@@ -13,7 +13,7 @@ void add_generate_command(CLI::App& app, Command& command) {
     auto output = std::make_shared<std::string>("-");
     auto uniform = std::make_shared<bool>(false);
     CLI::App* sub = app.add_subcommand("generate", "Write a seeded random set of primitives (survey XML, or .hbvh)");
-    sub->add_option("--count", options->count, "Number of primitives")->capture_default_str()->check(CLI::Range(1u, 100000000u));
+    sub->add_option("--count", options->count, "Number of primitives")->capture_default_str()->check(whole_number(1, 100000000));
     sub->add_option("--seed", options->seed, "Random seed")->capture_default_str()->check(seed_validator());
     sub->add_flag("--uniform", *uniform, "Scatter uniformly instead of in clusters");
     sub->add_option("-o,--output", *output, "Output file (survey XML; .hbvh: binary), or - for stdout")->capture_default_str();

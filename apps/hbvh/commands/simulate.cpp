@@ -60,7 +60,7 @@ void add_simulate_command(CLI::App& app, Command& command) {
     args->builder.add_refit_to(*sub);
     sub->add_option("--collisions", args->options.collision_count, "Root-overlapping queries to measure")
         ->capture_default_str()
-        ->check(CLI::Range(1u, 10000000u));
+        ->check(whole_number(1, 10000000));
     sub->add_option("--seed", args->options.seed, "Seed of the start states")
         ->capture_default_str()
         ->check(seed_validator());

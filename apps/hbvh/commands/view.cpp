@@ -1,9 +1,12 @@
 // SPDX-License-Identifier: MIT
 // `hbvh view`: one self-contained HTML page that shows a hierarchy level by level.
+#include <fmt/core.h>
+
 #include <filesystem>
 #include <memory>
 
 #include "commands/command.hpp"
+#include "hbvh/io/file.hpp"
 #include "hbvh/io/view_html.hpp"
 
 namespace hbvh::cli {
@@ -17,6 +20,14 @@ struct ViewArguments {
 };
 
 int run_view(const ViewArguments& args) {
+    // The page is HTML whatever the name says; an extension of another format is a mistake best caught before
+    // the build (a .gltf holding HTML would fail later, in another program).
+    if (const std::string extension = lower_case_extension(args.output);
+        args.output != "-" && !extension.empty() && extension != ".html" && extension != ".htm") {
+        fmt::print(stderr, "hbvh view: the output '{}' is not named .html: view writes an HTML page (for glTF, DOT or "
+                           "SVG use `hbvh export`)\n", args.output);
+        return exit_bad_usage;
+    }
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
