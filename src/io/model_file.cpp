@@ -3,7 +3,9 @@
 #include "hbvh/io/model_file.hpp"
 
 #include <algorithm>
+#include <array>
 #include <filesystem>
+#include <fstream>
 #include <iterator>
 #include <span>
 #include <system_error>
@@ -36,6 +38,17 @@ Result<ModelFile> from_binary(Result<Bvh> bvh) {
         model.hierarchy = std::move(bvh.value());
     }
     return model;
+}
+
+/// Whether the regular file at `path` begins with the .hbvh magic bytes (false when it cannot be read: the
+/// importer that reads it next says why; and for pipes, whose bytes a peek would take from the importer).
+bool starts_with_binary_magic(const std::string& path) {
+    std::error_code ignored;
+    if (!std::filesystem::is_regular_file(path, ignored)) return false;
+    std::ifstream file(path, std::ios::binary);
+    std::array<char, 8> head{};
+    file.read(head.data(), head.size());
+    return has_binary_magic(std::as_bytes(std::span(head.data(), static_cast<std::size_t>(file.gcount()))));
 }
 
 /// A survey XML file's contents.
@@ -116,6 +129,11 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
                              ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
                          path};
     }
+    // An importer would read a binary hierarchy as XML or a mesh and report a "line" of it; say what it is instead.
+    if (!automatic && starts_with_binary_magic(path))
+        return Error{"the file is an .hbvh hierarchy (its first bytes say so), not " + std::string(format) +
+                         "; drop --format, or give --format hbvh",
+                     path};
     return from_import(import_primitives(path, chosen->second), path);
 }
 

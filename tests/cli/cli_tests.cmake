@@ -196,6 +196,11 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
 
+# An importer's --format on a binary hierarchy names what the file is, not a "line" of it as XML.
+add_test(NAME cli.format_importer_on_binary
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}
+                 -P ${CMAKE_CURRENT_LIST_DIR}/format_on_binary.cmake)
+
 # view writes HTML: an output named for another format is a usage error, before anything is built or written.
 hbvh_cli_test(view.not_html 2 "is not named .html" view ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -o ${HBVH_CLI_OUT}/view.gltf)
