@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iterator>
 #include <span>
+#include <string_view>
 #include <system_error>
 #include <utility>
 
@@ -49,6 +50,29 @@ bool starts_with_binary_magic(const std::string& path) {
     std::array<char, 8> head{};
     file.read(head.data(), head.size());
     return has_binary_magic(std::as_bytes(std::span(head.data(), static_cast<std::size_t>(file.gcount()))));
+}
+
+/// The name of the first element of an XML text, after a byte order mark, blanks, the declaration, processing
+/// instructions, comments and a DOCTYPE; empty when the text does not start like XML. Reads only that prolog.
+std::string_view root_element_name(std::string_view text) {
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
+    const auto skip_past = [&](std::string_view end) {
+        const std::size_t at = text.find(end);
+        text.remove_prefix(at == std::string_view::npos ? text.size() : at + end.size());
+    };
+    for (;;) {
+        const std::size_t start = text.find_first_not_of(" \t\r\n");
+        if (start == std::string_view::npos) return {};
+        text.remove_prefix(start);
+        if (text.starts_with("<?")) skip_past("?>");
+        else if (text.starts_with("<!--")) skip_past("-->");
+        else if (text.starts_with("<!")) skip_past(">");
+        else break;
+    }
+    if (!text.starts_with('<')) return {};
+    text.remove_prefix(1);
+    const std::size_t end = text.find_first_of(" \t\r\n/>");
+    return text.substr(0, end == std::string_view::npos ? text.size() : end);
 }
 
 /// A survey XML file's contents.
@@ -117,9 +141,10 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         if (!text) return text.error();
         const std::span<const std::byte> raw = std::as_bytes(std::span(text.value()));
         if (has_binary_magic(raw)) return from_binary(read_binary(raw, path));
-        // An .xml whose root is <mujoco> is MJCF (the importer below takes it), unless the format says otherwise.
-        const bool survey = !automatic || (by_bytes ? text->find("<hierarchy") != std::string::npos
-                                                    : text->find("<mujoco") == std::string::npos);
+        // An .xml whose root is <mujoco> (MJCF) or <robot> (URDF) goes to the importer below, unless the format
+        // says otherwise; the root's name, not a search of the text, which a comment could fool either way.
+        const std::string_view root = root_element_name(text.value());
+        const bool survey = !automatic || (by_bytes ? root == "hierarchy" : root != "mujoco" && root != "robot");
         // The XML reader takes the text over: a 230 MB file is parsed where it was read, not copied.
         if (survey) return from_xml(detail::read_xml_taking(std::move(text).value(), path));
         if (by_bytes)

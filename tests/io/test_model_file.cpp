@@ -159,6 +159,27 @@ TEST_F(ModelFileTest, ImportersByExtensionRootAndFormat) {
     EXPECT_NE(forced.error().message.find("expected <robot>"), std::string::npos);
 }
 
+TEST_F(ModelFileTest, TheRootElementDecidesAnXmlFileNotATextSearch) {
+    // A URDF saved as .xml is URDF: the same primitives as under its own name.
+    const fs::path data = test::test_data_dir();
+    std::ifstream urdf_file(data / "urdf_chain.urdf");
+    const std::string urdf_text((std::istreambuf_iterator<char>(urdf_file)), std::istreambuf_iterator<char>());
+    write("chain.xml", urdf_text);
+    const Result<ModelFile> urdf = read_model_file(path("chain.xml"));
+    ASSERT_TRUE(urdf.has_value()) << urdf.error().to_string();
+    EXPECT_EQ(urdf->primitives.size(), 4u);
+    // A survey hierarchy that mentions <mujoco> in a comment is still a survey hierarchy, its tree kept; after a
+    // declaration, a comment and a DOCTYPE the root is found all the same.
+    write("tree.xml", "<?xml version=\"1.0\"?>\n<!-- converted from a <mujoco> model -->\n<!DOCTYPE hierarchy>\n"
+                      "<hierarchy>\n<volume type=\"sphere\" pos=\"0 0 0\" radius=\"2\">\n"
+                      "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"1\"/>\n"
+                      "  <volume type=\"sphere\" pos=\"0.5 0 0\" radius=\"1\"/>\n</volume>\n</hierarchy>\n");
+    const Result<ModelFile> tree = read_model_file(path("tree.xml"));
+    ASSERT_TRUE(tree.has_value()) << tree.error().to_string();
+    EXPECT_TRUE(tree->hierarchy.has_value());
+    EXPECT_EQ(tree->primitives.size(), 2u);
+}
+
 TEST_F(ModelFileTest, RefusesDirectoriesUnknownFormatsAndFilesWithoutPrimitives) {
     fs::create_directories(folder_ / "scene.xml");
     const Result<ModelFile> directory = read_model_file(path("scene.xml"));
