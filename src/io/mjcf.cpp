@@ -400,7 +400,10 @@ private:
         // Stage 3: the frame, from fromto (which overrides pos and orientation) or from pos + orientation.
         RigidTransform local;
         const FoundAttribute fromto = find_attribute(geom, chain, "fromto");
-        const bool uses_fromto = fromto.value != nullptr && type != "sphere";
+        // MuJoCo refuses a sphere with fromto (from its class too): it has no axis to lay along the segment.
+        if (fromto.value != nullptr && type == "sphere")
+            return error_at(fromto.element, "fromto needs a capsule, cylinder, box or ellipsoid, not a sphere (as in MuJoCo)");
+        const bool uses_fromto = fromto.value != nullptr;
         if (uses_fromto) {
             Result<std::vector<double>> ends = numbers(fromto, "fromto", 6);
             if (!ends) return ends.error();

@@ -365,6 +365,10 @@ TEST(Mjcf, ErrorsNameFileLineAndProblem) {
         {"<mujoco>\n<worldbody>\n<geom type=\"capsule\" size=\"1\" fromto=\"1 1 1 1 1 1\"/>\n</worldbody></mujoco>", 3,
          "fromto"},
         {"<mujoco>\n<worldbody>\n<geom type=\"cone\" size=\"1\"/>\n</worldbody></mujoco>", 3, "unknown geom type"},
+        {"<mujoco>\n<worldbody>\n<geom type=\"sphere\" size=\"1\" fromto=\"0 0 0 1 0 0\"/>\n</worldbody></mujoco>", 3,
+         "fromto needs a capsule, cylinder, box or ellipsoid, not a sphere"},
+        {"<mujoco>\n<default>\n<geom fromto=\"0 0 0 1 0 0\"/>\n</default>\n<worldbody>\n<geom type=\"sphere\" size=\"1\"/>\n"
+         "</worldbody></mujoco>", 3, "not a sphere"},
         {"<mujoco>\n<compiler angle=\"grad\"/>\n</mujoco>", 2, "angle"},
         {"<mujoco>\n<compiler coordinate=\"global\"/>\n</mujoco>", 2, "global"},
         {"<mujoco>\n<worldbody>\n<geom size=\"1\" quat=\"0 0 0 0\"/>\n</worldbody></mujoco>", 3, "degenerate"},
