@@ -10,16 +10,22 @@ namespace {
 // Below this length a direction carries no information; MuJoCo uses a similar cut-off (mjMINVAL).
 constexpr double tiny_length = 1e-14;
 
+// Lengths are taken with Eigen's stableNorm, which scales before it squares: a quaternion or axis of 1e160 parts
+// is as valid as one of 1 (the parts are finite), and a plain norm() overflowed there to infinity, which divided
+// every part to 0 (the identity, or a matrix that is no rotation).
+
 }  // namespace
 
 std::optional<Mat3> rotation_from_quat(double w, double x, double y, double z) {
     Eigen::Quaterniond q(w, x, y, z);
-    if (q.norm() < tiny_length) return std::nullopt;
-    return q.normalized().toRotationMatrix();
+    const double length = q.coeffs().stableNorm();
+    if (length < tiny_length) return std::nullopt;
+    q.coeffs() /= length;
+    return q.toRotationMatrix();
 }
 
 std::optional<Mat3> rotation_from_axis_angle(const Vec3& axis, double angle) {
-    const double length = axis.norm();
+    const double length = axis.stableNorm();
     if (length < tiny_length) return std::nullopt;
     return Eigen::AngleAxisd(angle, axis / length).toRotationMatrix();
 }
@@ -45,12 +51,12 @@ std::optional<Mat3> rotation_from_euler(const Vec3& angles, std::string_view seq
 }
 
 std::optional<Mat3> rotation_from_xy_axes(const Vec3& x, const Vec3& y) {
-    const double x_length = x.norm();
+    const double x_length = x.stableNorm();
     if (x_length < tiny_length) return std::nullopt;
     const Vec3 x_unit = x / x_length;
     // Gram-Schmidt: only the part of y orthogonal to x counts, as in MuJoCo.
     const Vec3 y_orthogonal = y - x_unit.dot(y) * x_unit;
-    const double y_length = y_orthogonal.norm();
+    const double y_length = y_orthogonal.stableNorm();
     if (y_length < tiny_length) return std::nullopt;
     Mat3 rotation;
     rotation.col(0) = x_unit;
@@ -60,7 +66,7 @@ std::optional<Mat3> rotation_from_xy_axes(const Vec3& x, const Vec3& y) {
 }
 
 std::optional<Mat3> rotation_from_z_axis(const Vec3& z) {
-    const double length = z.norm();
+    const double length = z.stableNorm();
     if (length < tiny_length) return std::nullopt;
     const Vec3 direction = z / length;
     const Vec3 axis = Vec3::UnitZ().cross(direction);

@@ -331,6 +331,32 @@ TEST(Mjcf, FrameElementComposes) {
     EXPECT_NEAR((box.rotation.col(0) - Vec3(0, 1, 0)).norm(), 0.0, 1e-12);
 }
 
+TEST(Mjcf, HugeOrientationNumbersTurnAsTheirDirectionSays) {
+    // Every orientation form scaled by 1e155-1e300 (finite, but its square is not) turns as the unit form: a plain
+    // norm overflowed, and the geoms came out unturned or with a matrix that is no rotation.
+    TempDir folder;
+    const auto box_axes = [&](const std::string& orientation) {
+        const fs::path file = folder.path / "turned.xml";
+        std::ofstream(file) << "<mujoco><worldbody><body " << orientation
+                            << "><geom type=\"box\" size=\"1 2 3\"/></body></worldbody></mujoco>";
+        const Result<ImportResult> imported = import_mjcf(file.string());
+        EXPECT_TRUE(imported.has_value()) << orientation << ": " << imported.error().to_string();
+        return imported ? std::get<Obb>(imported->primitives.at(0).volume).rotation : Mat3(Mat3::Zero());
+    };
+    const std::pair<const char*, const char*> same[] = {
+        {R"(quat="1e160 0 0 1e160")", R"(quat="1 0 0 1")"},
+        {R"(quat="1e300 1e300 0 0")", R"(quat="1 1 0 0")"},
+        {R"(zaxis="1e160 0 0")", R"(zaxis="1 0 0")"},
+        {R"(axisangle="1e155 0 0 90")", R"(axisangle="1 0 0 90")"},
+        {R"(xyaxes="1e300 0 0 0 1e300 1e300")", R"(xyaxes="1 0 0 0 1 1")"},
+    };
+    for (const auto& [huge, unit] : same) {
+        const Mat3 expected = box_axes(unit);
+        EXPECT_LT((box_axes(huge) - expected).cwiseAbs().maxCoeff(), 1e-12) << huge;
+        EXPECT_GT((expected - Mat3::Identity()).cwiseAbs().maxCoeff(), 0.5) << unit << " turns nothing";
+    }
+}
+
 TEST(Mjcf, MeshGeomsAndGeneratorsAreReportedAndSkipped) {
     TempDir folder;
     const fs::path file = folder.path / "mesh.xml";
