@@ -148,8 +148,20 @@ private:
             pugi::xml_node patched_collision = patched_link.child("collision");
             for (const pugi::xml_node& collision : link.children("collision")) {
                 CollisionSite site{collision, std::nullopt};
-                const pugi::xml_node shape_element = collision.child("geometry").first_child();
+                // The shape is the geometry's first element (a comment before it is no shape). It holds one; urdfdom
+                // reads the first and drops the rest without a word.
+                pugi::xml_node shape_element;
+                std::size_t shapes = 0;
+                for (const pugi::xml_node& child : collision.child("geometry").children()) {
+                    if (child.type() != pugi::node_element) continue;
+                    if (shapes++ == 0) shape_element = child;
+                }
                 const std::string_view shape_name = shape_element ? shape_element.name() : "";
+                if (shapes > 1)
+                    result_.warnings.push_back(source_->warning_at(
+                        collision.child("geometry"), "<geometry> holds " + std::to_string(shapes) +
+                                                         " shapes; only the first, <" + std::string(shape_name) +
+                                                         ">, is read (a URDF geometry has one)"));
                 if (shape_name != "box" && shape_name != "sphere" && shape_name != "cylinder" && shape_name != "mesh" &&
                     shape_name != "capsule") {
                     // urdfdom 3 drops such a collision silently; say so, and keep our list in step with its list.

@@ -117,6 +117,18 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
     ASSERT_EQ(imported->warnings.size(), 1u);
     EXPECT_NE(imported->warnings[0].find("cone.urdf:3: collision with unknown geometry <cone>"), std::string::npos)
         << imported->warnings[0];
+    // A second shape in one <geometry> is dropped by urdfdom: the import says so, at the geometry's line.
+    const fs::path two = folder / "two.urdf";
+    std::ofstream(two) << "<robot name=\"r\">\n<link name=\"a\">\n<collision>\n<geometry><sphere radius=\"1\"/>"
+                          "<box size=\"1 1 1\"/></geometry>\n</collision></link>\n</robot>";
+    const Result<ImportResult> first_only = import_urdf(two.string());
+    ASSERT_TRUE(first_only.has_value()) << first_only.error().to_string();
+    ASSERT_EQ(first_only->primitives.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<Sphere>(first_only->primitives[0].volume));
+    ASSERT_EQ(first_only->warnings.size(), 1u);
+    EXPECT_NE(first_only->warnings[0].find("two.urdf:4: <geometry> holds 2 shapes; only the first, <sphere>, is read"),
+              std::string::npos)
+        << first_only->warnings[0];
     fs::remove_all(folder);
 }
 
