@@ -7,6 +7,8 @@
 #include <cmath>
 #include <cstdint>
 #include <regex>
+#include <type_traits>
+#include <variant>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
@@ -34,7 +36,28 @@ struct MeshInstance {
     std::string name;
     CollisionKind kind = CollisionKind::none;
     std::vector<Sphere> points;  // Vertices as radius-0 spheres, the fitters' input.
+    double rounding = 0.0;       // How far a vertex may lie from the file's own (single_precision_reach).
 };
+
+/// How far a vertex that assimp read and placed may lie from where the file puts it, for a vertex whose coordinates
+/// are at most `magnitude` in size (the largest |M v| + |t| row sum of its transform): assimp reads and transforms
+/// in single precision (Debian builds it without ASSIMP_DOUBLE_PRECISION). Parsing text is within an ulp, and each
+/// coordinate's three products and sums round at most 2.5 ulps of that magnitude more: 4 ulps per coordinate,
+/// times sqrt(3) for the distance. At 10^6 (an ulp of 0.0625) that is 0.43; at 1, 8e-7.
+double single_precision_reach(double magnitude) {
+    static_assert(std::is_same_v<ai_real, float>, "with a double-precision assimp this margin is far too large");
+    if (!(magnitude > 0.0)) return 0.0;
+    const double ulp = std::ldexp(1.0, std::max(std::ilogb(magnitude), -126) - 23);  // of a float as large
+    return std::sqrt(3.0) * 4.0 * ulp;
+}
+
+/// `volume` grown by `margin` in every direction: boxes by their half extents, spheres and capsules by the radius.
+void grow(BoundingVolume& volume, double margin) {
+    if (auto* sphere = std::get_if<Sphere>(&volume)) sphere->radius += margin;
+    else if (auto* capsule = std::get_if<Capsule>(&volume)) capsule->radius += margin;
+    else if (auto* box = std::get_if<Obb>(&volume)) box->half_extents.array() += margin;
+    else if (auto* aabb = std::get_if<Aabb>(&volume)) aabb->min.array() -= margin, aabb->max.array() += margin;
+}
 
 // assimp reports parse errors as text; some of them carry "line N".
 int line_in(const std::string& message) {
@@ -63,12 +86,23 @@ Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatri
         if (node.mNumMeshes > 1) name += "_" + std::to_string(i);
         MeshInstance instance{name, kind, {}};
         instance.points.reserve(mesh.mNumVertices);
+        double magnitude = 0.0;
         for (unsigned v = 0; v < mesh.mNumVertices; ++v) {
-            const aiVector3D world = transform * mesh.mVertices[v];
+            const aiVector3D& local = mesh.mVertices[v];
+            const aiVector3D world = transform * local;
             const Vec3 point(world.x, world.y, world.z);
-            if (!point.allFinite()) return Error("mesh '" + name + "' has a vertex that is not finite", path);
+            if (!point.allFinite())
+                return Error("mesh '" + name + "' has a vertex that is not finite (meshes are read in single precision, "
+                             "whose range ends at 3.4e38)",
+                             path);
             instance.points.push_back({point, 0.0});
+            for (unsigned row = 0; row < 3; ++row)
+                magnitude = std::max(magnitude, std::abs(double(transform[row][0]) * local.x) +
+                                                    std::abs(double(transform[row][1]) * local.y) +
+                                                    std::abs(double(transform[row][2]) * local.z) +
+                                                    std::abs(double(transform[row][3])));
         }
+        instance.rounding = single_precision_reach(magnitude);
         out.push_back(std::move(instance));
     }
     for (unsigned c = 0; c < node.mNumChildren; ++c)
@@ -139,6 +173,8 @@ Result<ImportResult> import_mesh(const std::string& path, const MeshImportOption
                                           .to_string());
             continue;
         }
+        // The fit encloses the vertices as assimp gave them; grown by their rounding, the file's own vertices too.
+        grow(volume, instance.rounding);
         result.primitives.push_back({std::move(volume), instance.name});
     }
     if (ignored > 0)
