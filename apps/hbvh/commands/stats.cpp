@@ -71,11 +71,20 @@ int run_stats(const StatsArguments& args) {
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
+    Result<BuildRequest> request = args.builder.resolve();
+    if (!request) {
+        fmt::print(stderr, "hbvh stats: {}\n", request.error().to_string());
+        return exit_bad_usage;
+    }
     // A stored hierarchy is measured as it is, violations and all: stats is how a user checks a file.
-    Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : hierarchy_of(model.value(), args.builder);
+    Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : request->run(model->primitives);
     if (!bvh) return report_error(bvh.error());
     const std::vector<ContainmentViolation> violations = containment_violations(bvh.value());
-    const Stats stats = compute_stats(bvh.value());
+    // --type-weight weighs each volume of `cost` (and of `calibrated_cost`), as `build --stats` does; `cost` stays
+    // Eq. 2's volume measure whatever --objective the tree was built for.
+    VolumePolicy weighted = request->context.policy;
+    weighted.measure = NodeMeasure::volume;
+    const Stats stats = compute_stats(bvh.value(), weighted);
     if (args.json) {
         nlohmann::ordered_json out = to_json(stats);
         out["violations"] = violations_json(model.value(), bvh.value(), violations);
