@@ -3,6 +3,8 @@
 // the locations of warnings, and for <capsule>, which urdfdom does not know and would reject the model for.
 #include "hbvh/io/urdf.hpp"
 
+#include <algorithm>
+#include <charconv>
 #include <map>
 #include <mutex>
 #include <optional>
@@ -53,6 +55,42 @@ RigidTransform to_transform(const urdf::Pose& pose) {
     Eigen::Quaterniond q(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
     if (q.norm() > 0.0) transform.rotation = q.normalized().toRotationMatrix();
     return transform;
+}
+
+// A numeric attribute of a collision, checked here because urdfdom reports any fault in one only as "read a
+// different number of collisions": `count` finite numbers (`at_least_zero`: none negative). A valid value is
+// written back into `patched` (the same element of the copy urdfdom reads) in a form urdfdom accepts, which
+// refuses surrounding blanks that URDF files in the wild have (" 1 ").
+struct NumberRule {
+    const char* attribute;
+    std::size_t count;
+    bool at_least_zero;
+    bool required;
+};
+
+Status check_numbers(const XmlSource& source, const pugi::xml_node& element, pugi::xml_node patched,
+                     const NumberRule& rule) {
+    const pugi::xml_attribute attribute = element.attribute(rule.attribute);
+    const std::string where = "<" + std::string(element.name()) + "> attribute '" + rule.attribute + "'";
+    if (!attribute) {
+        if (!rule.required) return Ok{};
+        return source.error_at(element, where + " is missing");
+    }
+    const std::optional<std::vector<double>> values = detail::parse_numbers(attribute.value());
+    if (!values || values->size() != rule.count)
+        return source.error_at(element, where + " needs " + std::to_string(rule.count) + " finite number" +
+                                            (rule.count == 1 ? "" : "s") + ", found \"" + attribute.value() + "\"");
+    if (rule.at_least_zero && std::any_of(values->begin(), values->end(), [](double v) { return v < 0.0; }))
+        return source.error_at(element, where + " must not be negative, found \"" + attribute.value() + "\"");
+    std::string canonical;
+    for (double v : *values) {
+        char text[32];
+        const auto [end, code] = std::to_chars(text, text + sizeof text, v);  // shortest form that reads back exactly
+        if (!canonical.empty()) canonical += ' ';
+        canonical.append(text, end);
+    }
+    patched.attribute(rule.attribute).set_value(canonical.c_str());
+    return Ok{};
 }
 
 // The element named `name` (a link or joint) to locate an urdfdom message in the file; null when not found.
@@ -144,6 +182,8 @@ private:
     Status scan_collisions(const pugi::xml_node& robot, const pugi::xml_node& patched_robot) {
         pugi::xml_node patched_link = patched_robot.child("link");
         for (const pugi::xml_node& link : robot.children("link")) {
+            // urdfdom refuses a nameless link as "a different number of collisions" too.
+            if (link.attribute("name").as_string()[0] == '\0') return source_->error_at(link, "<link> without a name");
             std::vector<CollisionSite>& sites = collisions_[link.attribute("name").as_string("")];
             pugi::xml_node patched_collision = patched_link.child("collision");
             for (const pugi::xml_node& collision : link.children("collision")) {
@@ -174,6 +214,22 @@ private:
                     patched_collision = next;
                     continue;
                 }
+                // The collision's numbers, with their lines (a capsule's are read below).
+                const pugi::xml_node origin = collision.child("origin");
+                for (const char* attribute : {"xyz", "rpy"})
+                    if (origin)
+                        if (Status checked = check_numbers(*source_, origin, patched_collision.child("origin"),
+                                                           {attribute, 3, false, false});
+                            !checked)
+                            return checked;
+                const pugi::xml_node patched_shape = patched_collision.child("geometry").child(shape_element.name());
+                std::vector<NumberRule> rules;
+                if (shape_name == "box") rules = {{"size", 3, true, true}};
+                if (shape_name == "sphere") rules = {{"radius", 1, true, true}};
+                if (shape_name == "cylinder") rules = {{"radius", 1, true, true}, {"length", 1, true, true}};
+                for (const NumberRule& rule : rules)
+                    if (Status checked = check_numbers(*source_, shape_element, patched_shape, rule); !checked)
+                        return checked;
                 if (const pugi::xml_node capsule = collision.child("geometry").child("capsule")) {
                     CapsuleShape shape;
                     for (auto [attribute, slot] : {std::pair{"radius", &shape.radius}, {"length", &shape.length}}) {

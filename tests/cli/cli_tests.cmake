@@ -57,7 +57,7 @@ hbvh_cli_rejects_import(mjcf_include_cycle.xml "mjcf_include_cycle.xml:2: includ
 hbvh_cli_rejects_import(mjcf_unknown_class.xml "mjcf_unknown_class.xml:2: unknown default class 'missing'")
 hbvh_cli_rejects_import(mjcf_only_plane.xml "mjcf_only_plane.xml: the file holds no collision primitives")
 hbvh_cli_rejects_import(mjcf_coincident_fromto.xml "mjcf_coincident_fromto.xml:2: fromto end points coincide")
-hbvh_cli_rejects_import(urdf_negative_box.urdf "urdf_negative_box.urdf:2: collision .* negative size")
+hbvh_cli_rejects_import(urdf_negative_box.urdf "urdf_negative_box.urdf:2: <box> attribute 'size' must not be negative")
 hbvh_cli_rejects_import(urdf_joint_loop.urdf "urdf_joint_loop.urdf:1: urdfdom rejected the model")
 hbvh_cli_rejects_import(urdf_wrong_root.urdf "urdf_wrong_root.urdf:1: root element is <mujoco>, expected <robot>")
 hbvh_cli_rejects_import(mesh_nan_vertex.obj "mesh_nan_vertex.obj: mesh 'UBX_box' has a vertex that is not finite")

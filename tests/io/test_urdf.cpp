@@ -96,6 +96,17 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
         {"<robot name=\"r\">\n<link name=\"a\"><collision><geometry>\n<capsule radius=\"x\" length=\"1\"/>"
          "</geometry></collision></link>\n</robot>",
          3, "capsule radius"},
+        // Numbers urdfdom would refuse only as "a different number of collisions", told with their line.
+        {"<robot name=\"r\">\n<link name=\"a\"><collision><geometry>\n<box size=\"1 2\"/>"
+         "</geometry></collision></link>\n</robot>",
+         3, "<box> attribute 'size' needs 3 finite numbers, found \"1 2\""},
+        {"<robot name=\"r\">\n<link name=\"a\"><collision>\n<origin xyz=\"nan 0 0\"/><geometry><sphere radius=\"1\"/>"
+         "</geometry></collision></link>\n</robot>",
+         3, "<origin> attribute 'xyz' needs 3 finite numbers"},
+        {"<robot name=\"r\">\n<link name=\"a\"><collision><geometry>\n<cylinder radius=\"-1\" length=\"1\"/>"
+         "</geometry></collision></link>\n</robot>",
+         3, "<cylinder> attribute 'radius' must not be negative"},
+        {"<robot name=\"r\">\n<link>\n</link>\n</robot>", 2, "<link> without a name"},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path file = folder / ("case" + std::to_string(i) + ".urdf");
@@ -117,6 +128,15 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
     ASSERT_EQ(imported->warnings.size(), 1u);
     EXPECT_NE(imported->warnings[0].find("cone.urdf:3: collision with unknown geometry <cone>"), std::string::npos)
         << imported->warnings[0];
+    // Blanks around a number, which urdfdom refuses, are read: the number is handed on in a form it takes.
+    const fs::path padded = folder / "padded.urdf";
+    std::ofstream(padded) << "<robot name=\"r\">\n<link name=\"a\"><collision><origin xyz=\" 1 2 3 \"/><geometry>"
+                             "<sphere radius=\" 0.5 \"/></geometry></collision></link>\n</robot>";
+    const Result<ImportResult> blanks = import_urdf(padded.string());
+    ASSERT_TRUE(blanks.has_value()) << blanks.error().to_string();
+    ASSERT_EQ(blanks->primitives.size(), 1u);
+    EXPECT_EQ(std::get<Sphere>(blanks->primitives[0].volume).radius, 0.5);
+    EXPECT_EQ(std::get<Sphere>(blanks->primitives[0].volume).center, Vec3(1, 2, 3));
     // A second shape in one <geometry> is dropped by urdfdom: the import says so, at the geometry's line.
     const fs::path two = folder / "two.urdf";
     std::ofstream(two) << "<robot name=\"r\">\n<link name=\"a\">\n<collision>\n<geometry><sphere radius=\"1\"/>"
