@@ -156,6 +156,8 @@ std::pair<std::size_t, std::size_t> refit_heaviest(Bvh& bvh, const BuildContext&
 }  // namespace
 
 Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context, const FastOptions& options) {
+    // Checked here, before the root's refit starts beside binned (whose own guard would come too late for it).
+    if (Status input = detail::check_build_input(primitives, context.policy); !input) return input.error();
     // binned reports its progress as the first half, the refits the second.
     BuildContext first_step = context;
     if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };

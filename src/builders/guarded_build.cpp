@@ -9,7 +9,8 @@
 
 namespace hbvh::detail {
 
-Status check_build_input(std::span<const Primitive> primitives) {
+Status check_build_input(std::span<const Primitive> primitives, const VolumePolicy& policy) {
+    if (Status usable = validate_policy(policy); !usable) return usable;
     if (primitives.empty()) return Error{"no primitives to build a hierarchy over"};
     if (Status valid = validate_primitives(primitives); !valid) return valid;
     return check_finite_extent(primitives);

@@ -44,9 +44,9 @@ private:
     std::thread::id caller_;
 };
 
-/// Ok, or the Error that refuses the input: empty, invalid geometry (validate_primitives), or a world box
-/// whose volume is not a finite normal double (check_finite_extent).
-[[nodiscard]] Status check_build_input(std::span<const Primitive> primitives);
+/// Ok, or the Error that refuses the input: a policy validate_policy refuses, no primitives, invalid geometry
+/// (validate_primitives), or a world box whose volume is not a finite normal double (check_finite_extent).
+[[nodiscard]] Status check_build_input(std::span<const Primitive> primitives, const VolumePolicy& policy);
 /// `built`, or an Error naming `builder` when the tree fails check_structure (a fitter that overflowed on
 /// extreme input would otherwise write NaN volumes into a file).
 [[nodiscard]] Result<Bvh> check_build_output(Result<Bvh> built, std::string_view builder);
@@ -60,7 +60,7 @@ private:
 template <class Body>
 Result<Bvh> guarded_build(std::span<const Primitive> primitives, const BuildContext& context, std::string_view builder,
                           double steps, Body&& body) {
-    if (Status input = check_build_input(primitives); !input) return input.error();
+    if (Status input = check_build_input(primitives, context.policy); !input) return input.error();
     const Checkpoint checkpoint(context, steps);
     try {
         checkpoint.step(0.0);

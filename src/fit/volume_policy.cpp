@@ -46,6 +46,20 @@ Result<VolumePolicy> parse_allowed_types(std::string_view list, VolumePolicy bas
     return base;
 }
 
+Status validate_policy(const VolumePolicy& policy) {
+    bool any = false;
+    for (BvType type : all_bv_types) {
+        if (!policy.is_allowed(type)) continue;
+        any = true;
+        const double weight = policy.weight_of(type);
+        if (!std::isfinite(weight) || !(weight > 0.0))
+            return Error{"volume policy: the weight of " + std::string(to_string(type)) + " is " + std::to_string(weight) +
+                         "; weights must be positive finite numbers"};
+    }
+    if (!any) return Error{"volume policy: no BV kind is allowed; allow at least one of aabb, obb, sphere, capsule"};
+    return Ok{};
+}
+
 Result<VolumePolicy> parse_type_weights(std::string_view list, VolumePolicy base) {
     for (std::string_view entry : split_list(list)) {
         const std::size_t equals = entry.find('=');

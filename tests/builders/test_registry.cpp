@@ -120,5 +120,30 @@ TEST(Registry, EveryBuilderRefusesBadInputTheSameWay) {
     }
 }
 
+TEST(Registry, EveryBuilderRefusesAPolicyItCannotWorkWith) {
+    // A NaN weight made binned recurse without end (a crash) and optimal and auto loop; no allowed kind gave
+    // trees of empty AABBs that enclose nothing.
+    const std::vector<Primitive> primitives = small_scene();
+    BuildContext nan_weight;
+    nan_weight.policy.weight[static_cast<std::size_t>(BvType::obb)] = std::numeric_limits<double>::quiet_NaN();
+    BuildContext negative_weight;
+    negative_weight.policy.weight[static_cast<std::size_t>(BvType::sphere)] = -1.0;
+    BuildContext nothing_allowed;
+    nothing_allowed.policy.allowed = {false, false, false, false};
+    BuildContext disallowed_nan;  // a kind that is not allowed may weigh anything
+    disallowed_nan.policy = VolumePolicy::only(BvType::aabb);
+    disallowed_nan.policy.weight[static_cast<std::size_t>(BvType::capsule)] = std::numeric_limits<double>::quiet_NaN();
+    for (const AlgorithmInfo& row : algorithms()) {
+        const Result<Bvh> nan = row.build(primitives, nan_weight);
+        ASSERT_FALSE(nan.has_value()) << row.name;
+        EXPECT_NE(nan.error().message.find("the weight of obb is nan"), std::string::npos) << nan.error().message;
+        ASSERT_FALSE(row.build(primitives, negative_weight).has_value()) << row.name;
+        const Result<Bvh> none = row.build(primitives, nothing_allowed);
+        ASSERT_FALSE(none.has_value()) << row.name;
+        EXPECT_NE(none.error().message.find("no BV kind is allowed"), std::string::npos) << none.error().message;
+        EXPECT_TRUE(row.build(primitives, disallowed_nan).has_value()) << row.name;
+    }
+}
+
 }  // namespace
 }  // namespace hbvh

@@ -43,6 +43,10 @@ struct VolumePolicy {
     [[nodiscard]] static VolumePolicy only(BvType type);
 };
 
+/// Ok, or the Error that refuses a policy no builder can work with: no kind allowed, or an allowed kind whose
+/// weight is not a positive finite number (a NaN weight made comparisons fail and builders recurse without end).
+/// Every builder checks it before it starts, as it checks the primitives.
+[[nodiscard]] Status validate_policy(const VolumePolicy& policy);
 /// Parses "aabb,obb,sphere,capsule" (any non-empty subset, any order). Error names the bad word.
 [[nodiscard]] Result<VolumePolicy> parse_allowed_types(std::string_view list, VolumePolicy base = {});
 /// Parses "obb=1.5,capsule=1.2" into weights (positive, finite). Error names the bad entry.
