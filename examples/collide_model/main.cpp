@@ -3,6 +3,7 @@
 #include <hbvh/hbvh.hpp>
 #include <cstdio>
 int main(int argc, char** argv) {
+    if (argc != 2) { std::fprintf(stderr, "usage: %s MODEL.xml\n", argv[0]); return 2; }  // (not in issue 12's text)
     auto model = hbvh::read_xml_file(argv[1]);            // survey XML primitive set
     if (!model) { std::fprintf(stderr, "%s\n", model.error().to_string().c_str()); return 1; }
     auto bvh = hbvh::build(model->primitives, hbvh::Algorithm::automatic);

@@ -1,6 +1,8 @@
 // SPDX-License-Identifier: MIT
 // validate_primitives / validate_pose / from_quaternion: what the library refuses, and that build(),
 // QueryTree and collide() refuse it too instead of pruning on it.
+#include <array>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -89,6 +91,22 @@ TEST(ValidatePose, RefusesNonRigidMotions) {
     EXPECT_FALSE(validate_pose(nan_translation));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(0, 0, 0, 0)));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(nan, 0, 0, 1)));
+    EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(std::numeric_limits<double>::infinity(), 0, 0, 1)));
+}
+
+TEST(ValidatePose, AnyNonZeroFiniteQuaternionGivesTheRotationOfItsDirection) {
+    // Components whose squares overflow or underflow (the plain norm's) were refused as "not finite".
+    const std::pair<std::array<double, 4>, std::array<double, 4>> same[] = {
+        {{1e-300, 1e-300, 0, 0}, {1, 1, 0, 0}},
+        {{4e-320, 0, 0, 0}, {1, 0, 0, 0}},
+        {{1e300, 1e300, 1e300, 1e300}, {1, 1, 1, 1}},
+    };
+    for (const auto& [tiny_or_huge, unit] : same) {
+        const RigidTransform pose = RigidTransform::from_quaternion(tiny_or_huge[0], tiny_or_huge[1], tiny_or_huge[2], tiny_or_huge[3]);
+        EXPECT_TRUE(validate_pose(pose)) << tiny_or_huge[0];
+        const RigidTransform expected = RigidTransform::from_quaternion(unit[0], unit[1], unit[2], unit[3]);
+        EXPECT_LT((pose.rotation - expected.rotation).cwiseAbs().maxCoeff(), 1e-15) << tiny_or_huge[0];
+    }
 }
 
 TEST(ValidatePose, TheQuickCheckAgreesWithTheWordedOne) {

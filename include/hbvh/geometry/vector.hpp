@@ -33,7 +33,9 @@ struct RigidTransform {
     [[nodiscard]] static RigidTransform from_quaternion(double w, double x, double y, double z,
                                                         const Vec3& translation = Vec3::Zero()) {
         const Eigen::Quaterniond q(w, x, y, z);
-        const double norm = q.norm();
+        // Scaled before it is squared (stableNorm): components of 1e300 or 1e-300 overflowed or underflowed the
+        // plain norm, and such a quaternion came out refused as non-finite.
+        const double norm = q.coeffs().stableNorm();
         if (!(norm > 0.0) || !std::isfinite(norm))
             return {Mat3::Constant(std::numeric_limits<double>::quiet_NaN()), translation};
         return {Eigen::Quaterniond(q.coeffs() / norm).toRotationMatrix(), translation};
