@@ -286,9 +286,11 @@ struct DecodeOutcome {
     std::size_t records_at = 0;  ///< Where the task's records start (for stage 4's offsets).
 };
 
-/// The node records (they follow the header) handed to `nodes`, with check_structure()'s tests made on the way.
+/// The node records (they follow the header) handed to `nodes`, with check_structure()'s tests made on the way;
+/// where `leaf_at` is given, the offset of each primitive's leaf record goes into it (for leaves_match_primitives).
 DecodeOutcome decode_node_records(const unsigned char* data, std::size_t end, std::uint64_t node_count,
-                                  std::uint64_t primitive_count, detail::BinaryNodeSink& nodes) {
+                                  std::uint64_t primitive_count, detail::BinaryNodeSink& nodes,
+                                  std::vector<std::uint64_t>* leaf_at) {
     DecodeOutcome outcome;
     outcome.records_at = binary_header_size;
     BinaryReader reader(data, end);
@@ -320,6 +322,7 @@ DecodeOutcome decode_node_records(const unsigned char* data, std::size_t end, st
             const std::uint64_t bit = std::uint64_t{1} << (node.primitive % 64);
             sound = node.primitive < primitive_count && (in_a_leaf[node.primitive / 64] & bit) == 0;
             if (sound) in_a_leaf[node.primitive / 64] |= bit;
+            if (sound && leaf_at != nullptr) (*leaf_at)[node.primitive] = at;
             ++leaf_count;
         } else {
             sound = node.child_count >= 2 && node.first_child == next_child &&
@@ -395,6 +398,23 @@ DecodeOutcome decode_primitive_records(const unsigned char* data, std::size_t en
     if (reader.left() != 0)
         return fail(reader.offset(), std::to_string(reader.left()) + " unused bytes between the names and the checksum");
     return outcome;
+}
+
+/// Whether every primitive record's volume is, byte for byte, its leaf record's (`leaf_at`, from a sound node
+/// pass): check_structure() requires a leaf to be its primitive, and a file stores both. One walk over the
+/// primitive records (from `records_at`), each compared with its leaf's bytes.
+bool leaves_match_primitives(const unsigned char* data, std::size_t end, std::size_t records_at,
+                             std::uint64_t primitive_count, const std::vector<std::uint64_t>& leaf_at) {
+    BinaryReader reader(data, end);
+    reader.skip(records_at);
+    for (std::uint64_t p = 0; p < primitive_count; ++p) {
+        const std::size_t at = reader.offset();
+        reader.skip_volume();
+        const std::size_t length = reader.offset() - at;
+        // The leaf's record holds its volume (kind byte first, so equal bytes mean the same kind) then its links.
+        if (leaf_at[p] + length > end || std::memcmp(data + at, data + leaf_at[p], length) != 0) return false;
+    }
+    return true;
 }
 
 }  // namespace
@@ -532,9 +552,15 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     }
     std::vector<DecodeOutcome> node_outcomes(node_sinks.size());
     DecodeOutcome primitives_outcome;
+    std::vector<std::uint64_t> leaf_at;  // filled by the first node pass, for leaves_match_primitives
     auto decode_nodes = [&](std::size_t pass) {
         node_sinks[pass]->reserve(node_count, primitive_count);
-        node_outcomes[pass] = decode_node_records(data, checksum_at, node_count, primitive_count, *node_sinks[pass]);
+        if (pass == 0 && node_count > 0 && count_problem.empty()) {
+            detail::reserve_on_huge_pages(leaf_at, primitive_count);
+            leaf_at.resize(primitive_count);
+        }
+        node_outcomes[pass] = decode_node_records(data, checksum_at, node_count, primitive_count, *node_sinks[pass],
+                                                  pass == 0 && !leaf_at.empty() ? &leaf_at : nullptr);
     };
     auto decode_primitives = [&] {
         if (primitives != nullptr) detail::reserve_on_huge_pages(*primitives, primitive_count);
@@ -559,6 +585,10 @@ Result<DecodedBinary> decode_binary(std::span<const std::byte> bytes, const std:
     decoded.primitive_count = primitive_count;
     decoded.sound = nodes_outcome.sound && primitives_outcome.sound;
     decoded.primitives_at = primitives_outcome.records_at;
+    // A sound node pass put every primitive in one leaf; the leaf must also be that primitive (stage 4's
+    // check_structure names the first that is not).
+    if (decoded.sound && node_count > 0)
+        decoded.sound = leaves_match_primitives(data, checksum_at, decoded.primitives_at, primitive_count, leaf_at);
     return decoded;
 }
 

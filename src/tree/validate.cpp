@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cstdio>
 #include <string>
+#include <type_traits>
+#include <variant>
 
 #include <tbb/parallel_invoke.h>
 
@@ -18,6 +20,22 @@ constexpr std::size_t concurrent_check_nodes = std::size_t{1} << 14;
 
 Error node_error(std::uint32_t index, const std::string& problem) {
     return Error{"node " + std::to_string(index) + ": " + problem};
+}
+
+/// Whether two volumes are the same kind with the same numbers (a leaf's copy of its primitive).
+bool same_volume(const BoundingVolume& a, const BoundingVolume& b) {
+    if (a.index() != b.index()) return false;
+    return std::visit(
+        [&](const auto& x) {
+            using Kind = std::decay_t<decltype(x)>;
+            const Kind& y = std::get<Kind>(b);
+            if constexpr (std::is_same_v<Kind, Aabb>) return x.min == y.min && x.max == y.max;
+            else if constexpr (std::is_same_v<Kind, Obb>)
+                return x.center == y.center && x.rotation == y.rotation && x.half_extents == y.half_extents;
+            else if constexpr (std::is_same_v<Kind, Sphere>) return x.center == y.center && x.radius == y.radius;
+            else return x.p0 == y.p0 && x.p1 == y.p1 && x.radius == y.radius;
+        },
+        a);
 }
 }  // namespace
 
@@ -39,6 +57,10 @@ Status check_structure(const Bvh& bvh) {
                 if (leaf_of[node.primitive] != UINT32_MAX)
                     return node_error(i, "primitive " + std::to_string(node.primitive) + " appears in two leaves");
                 leaf_of[node.primitive] = i;
+                // Queries test the leaf's volume and report its primitive: the two must be one shape (only the
+                // .hbvh format stores both, and a file could make them differ).
+                if (!same_volume(node.volume, bvh.primitives[node.primitive].volume))
+                    return node_error(i, "leaf volume differs from its primitive " + std::to_string(node.primitive) + "'s");
                 continue;
             }
             if (node.child_count < 2) return node_error(i, "inner node with a single child");

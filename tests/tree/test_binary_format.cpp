@@ -258,6 +258,29 @@ TEST(BinaryFormat, AHeaderDeclaringLessThanAHeaderAndChecksumIsRefusedAtItsSizeF
     EXPECT_EQ(back.error().message.rfind("offset 44: file is truncated: the header says ", 0), 0u) << back.error().message;
 }
 
+TEST(BinaryFormat, ALeafThatIsNotItsPrimitiveIsRefusedByBothReaders) {
+    // A sound tree in every other way, checksum and all, whose leaf of primitive 1 is a larger sphere: queries
+    // would test the leaf and report primitive 1 (the reviewed file gave 64 pairs where 8 were true).
+    Bvh bigger_leaf = small_tree();
+    std::get<Sphere>(bigger_leaf.nodes[4].volume).radius = 5.0;
+    const std::string bytes = write_binary(bigger_leaf);
+    const Result<Bvh> back = read(bytes);
+    ASSERT_FALSE(back.has_value());
+    // Node 4's record: header 40 + OBB 133 + AABB 61 + capsule (1 + 7 x 8 + 12) 69 + sphere 45.
+    EXPECT_EQ(back.error().message, "offset " + std::to_string(40 + 133 + 61 + 69 + 45) +
+                                        ": node 4: leaf volume differs from its primitive 1's");
+    expect_query_tree_agrees(bytes, back);
+    // Another kind in the leaf is refused alike.
+    Bvh other_kind = small_tree();
+    other_kind.nodes[6].volume = Aabb{Vec3(5.5, -0.5, -0.5), Vec3(6.5, 0.5, 0.5)};
+    const Result<Bvh> kind_back = read(write_binary(other_kind));
+    ASSERT_FALSE(kind_back.has_value());
+    EXPECT_NE(kind_back.error().message.find("node 6: leaf volume differs from its primitive 3's"), std::string::npos)
+        << kind_back.error().message;
+    // And check_structure refuses such a Bvh made in memory.
+    EXPECT_FALSE(check_structure(bigger_leaf));
+}
+
 TEST(BinaryFormat, EverySingleByteCorruptionIsRefused) {
     const std::string bytes = write_binary(small_tree());
     for (std::size_t at = 0; at < bytes.size(); ++at)

@@ -17,8 +17,9 @@ inline constexpr double default_containment_tolerance = 1e-9;
 /// The layout queries rely on, checked without reading out of bounds whatever the node array holds:
 /// child ranges inside the array (computed in 64 bits, so first_child + child_count cannot wrap),
 /// breadth-first order (the children of the inner nodes, taken in index order, tile nodes[1, n) exactly),
-/// no inner node with fewer than 2 children, every primitive in exactly one leaf, and every volume
-/// (nodes and primitives) usable geometry (volume_problem()). The Error names the first node that fails.
+/// no inner node with fewer than 2 children, every primitive in exactly one leaf whose volume is that primitive's
+/// (the same kind and numbers), and every volume (nodes and primitives) usable geometry (volume_problem()). The
+/// Error names the first node that fails.
 [[nodiscard]] Status check_structure(const Bvh& bvh);
 
 /// How far a primitive may reach beyond a node's volume before validate() calls it not enclosed:
