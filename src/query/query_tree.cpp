@@ -1,6 +1,7 @@
 // SPDX-License-Identifier: MIT
 // QueryTree: the read-only layout queries run on, converted once from a Bvh.
 #include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -196,6 +197,33 @@ Result<QueryTree> QueryTree::read_binary(std::span<const std::byte> bytes, std::
         return Error{"holds a primitive set, not a hierarchy: build one (hbvh build) before querying it", file};
     tree.finish();
     return tree;
+}
+
+Status validate(const QueryTree& tree, double relative_tolerance) {
+    std::vector<Sphere> spheres;
+    for (std::uint32_t i = 0; i < tree.nodes().size(); ++i) {
+        const QueryNode& node = tree.nodes()[i];
+        if (node.child_count == 0) continue;
+        const BoundingVolume& volume = tree.volume(i);
+        const double tolerance = containment_tolerance(volume, relative_tolerance);
+        double worst = tolerance;
+        std::optional<std::uint32_t> worst_primitive;
+        for (const std::uint32_t leaf : tree.leaves().subspan(node.leaf_begin, node.leaf_count)) {
+            spheres.clear();
+            append_generating_spheres(tree.volume(leaf), spheres);
+            const std::uint32_t primitive = tree.nodes()[leaf].primitive;
+            for (const Sphere& s : spheres)
+                if (const double reach = protrusion(volume, s);
+                    reach > worst || (worst_primitive && reach == worst && primitive < *worst_primitive))
+                    worst = reach, worst_primitive = primitive;
+        }
+        if (!worst_primitive) continue;
+        char by[32];
+        std::snprintf(by, sizeof by, "%.3g", worst);
+        return Error{"node " + std::to_string(i) + ": its " + std::string(to_string(type_of(volume))) +
+                     " does not contain primitive " + std::to_string(*worst_primitive) + " (by " + by + ")"};
+    }
+    return Ok{};
 }
 
 Result<QueryTree> QueryTree::read_binary_file(const std::filesystem::path& path) {

@@ -8,12 +8,15 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <variant>
+#include <type_traits>
 
 #include "hbvh/assert.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/builders/optimal.hpp"
 #include "hbvh/geometry/overlap.hpp"
 #include "hbvh/tree/stats.hpp"
+#include "hbvh/tree/validate.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/scene/generate.hpp"
 
@@ -425,6 +428,38 @@ TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {
     const Bvh empty;
     EXPECT_FALSE(collide(empty, pose, bvh, pose).intersecting);
     EXPECT_FALSE(collide_two_level(bvh, pose, empty, pose).intersecting);
+}
+
+TEST(QueryTreeValidate, AgreesWithTheBvhsValidateWordForWord) {
+    // validate(QueryTree), for trees loaded straight into the query layout, against validate(Bvh) (the oracle)
+    // on sound trees of several builders and on each of them with one inner volume shrunk.
+    const std::vector<Primitive> primitives = generate_scene({.count = 40, .seed = 8});
+    std::size_t refused = 0;
+    for (const Algorithm algorithm : {Algorithm::split, Algorithm::binned, Algorithm::two_level, Algorithm::fast}) {
+        Result<Bvh> bvh = build(primitives, algorithm);
+        ASSERT_TRUE(bvh.has_value()) << bvh.error().to_string();
+        EXPECT_TRUE(validate(QueryTree(*bvh))) << to_string(algorithm);
+        for (std::uint32_t i = 0; i < bvh->nodes.size(); ++i) {
+            if (bvh->nodes[i].is_leaf()) continue;
+            Bvh shrunk = *bvh;
+            // The node's volume, moved by a tenth of its size: some primitive below then sticks out.
+            std::visit([&](auto& v) {
+                using Kind = std::decay_t<decltype(v)>;
+                const double shift = 0.1 * size_scale(shrunk.nodes[i].volume);
+                if constexpr (std::is_same_v<Kind, Aabb>) v.min.x() += shift, v.max.x() += shift;
+                else if constexpr (std::is_same_v<Kind, Capsule>) v.p0.x() += shift, v.p1.x() += shift;
+                else v.center.x() += shift;
+            }, shrunk.nodes[i].volume);
+            const Status by_bvh = validate(shrunk);
+            const Status by_query_tree = validate(QueryTree(shrunk));
+            ASSERT_EQ(by_bvh.has_value(), by_query_tree.has_value()) << "node " << i;
+            if (!by_bvh) {
+                EXPECT_EQ(by_query_tree.error().message, by_bvh.error().message);
+                ++refused;
+            }
+        }
+    }
+    EXPECT_GT(refused, 10u);
 }
 
 TEST(TandemTraversal, StackBoundCoversTwoLevelFanOut) {

@@ -14,6 +14,7 @@
 
 #include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
+#include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
 
@@ -149,6 +150,13 @@ private:
     double coordinate_bound_ = 0.0;
     double extent_bound_ = 0.0;
 };
+
+/// The containment check of a loaded tree, as validate(const Bvh&) makes it after check_structure(): every inner
+/// node's volume holds every leaf below it (relative tolerance, see containment_tolerance). For a program that
+/// loads with QueryTree::read_binary_file, which, as every reader, checks the structure (and that each leaf is its
+/// primitive) but not containment. O(n x depth). The Error names the first node that fails and its primitive
+/// that reaches furthest out, in validate()'s words.
+[[nodiscard]] Status validate(const QueryTree& tree, double relative_tolerance = default_containment_tolerance);
 
 /// The pose of b's model frame relative to a's: maps b-model coordinates to a-model coordinates.
 /// Queries run in a's model frame, so this is the one transform a query computes.
