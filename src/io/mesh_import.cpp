@@ -112,7 +112,8 @@ Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatri
 
 // Whether a fitted volume has positive size in every dimension the survey format writes (sphere and capsule
 // radius, every box extent). Vertices that all coincide, or lie on a line or in a plane, fit volumes with a zero
-// size, which the XML reader (rightly) refuses, so they would make files hbvh cannot read back.
+// size: valid primitives, but in a collision mesh a stand-in or a mistake more often than a shape, so they are
+// skipped with a warning, as URDF's zero-size placeholders are.
 bool has_positive_size(const BoundingVolume& volume) {
     if (const auto* sphere = std::get_if<Sphere>(&volume)) return sphere->radius > 0.0;
     if (const auto* capsule = std::get_if<Capsule>(&volume)) return capsule->radius > 0.0;

@@ -565,7 +565,9 @@ Result<BoundingVolume> Reader::read_round(const pugi::xml_node& element, const V
                                           const Vec3& centre, std::string_view type_name) const {
     const Result<pugi::xml_attribute> radius_attribute = required(element, attributes, Key::radius, type_name);
     if (!radius_attribute) return radius_attribute.error();
-    const Result<double> radius = read_size(element, *radius_attribute, false);
+    // Radius 0 (a point, a segment) is a valid primitive in the library, and build() keeps it: the file must
+    // be able to hold what the writer writes.
+    const Result<double> radius = read_size(element, *radius_attribute, true);
     if (!radius) return radius.error();
     if (type == BvType::sphere) return BoundingVolume(Sphere{centre, *radius});
 
@@ -598,7 +600,7 @@ Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const Vol
         const Result<pugi::xml_attribute> attribute =
             required(element, attributes, axes[static_cast<std::size_t>(axis)], type_name);
         if (!attribute) return attribute.error();
-        const Result<double> extent = read_size(element, *attribute, false);
+        const Result<double> extent = read_size(element, *attribute, true);  // 0: a flat box
         if (!extent) return extent.error();
         extents[axis] = *extent;
     }
@@ -611,13 +613,13 @@ Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const Vol
         const Aabb box{centre - half, centre + half};
         if (!box.min.allFinite() || !box.max.allFinite())
             return error(line_of(element), "box corners overflow the range of double");
-        if (((box.max - box.min).array() <= 0.0).any())
+        if (((box.max - box.min).array() <= 0.0 && extents.array() > 0.0).any())
             return error(line_of(element), "box extents vanish in rounding: they are too small for its position");
         return BoundingVolume(box);
     }
-    // An OBB stores half sizes: a positive size whose half is 0 or subnormal would be a box no writer can give
-    // back (width="0", which this reader refuses) or one the library refuses without naming the line.
-    if ((half.array() < std::numeric_limits<double>::min()).any())
+    // An OBB stores half sizes: a positive size whose half is 0 or subnormal would be a box the writer gives back
+    // as another (width="0") or one the library refuses without naming the line.
+    if ((half.array() < std::numeric_limits<double>::min() && extents.array() > 0.0).any())
         return error(line_of(element), "box sizes are too small: half of each must be a normal double (sizes of at "
                                        "least 4.5e-308)");
     const Result<Mat3> rotation = read_orientation(element, orientation_attribute);
@@ -672,6 +674,11 @@ Result<double> Reader::read_size(const pugi::xml_node& element, const pugi::xml_
     const Result<std::array<double, 1>> numbers = read_numbers<1>(element, attribute);
     if (!numbers) return numbers.error();
     const double value = (*numbers)[0];
+    // A subnormal size is refused here, with its line, as validate_primitives() would refuse it without one.
+    if (value > 0.0 && value < std::numeric_limits<double>::min())
+        return error(line_of(attribute, element), "attribute '" + std::string(attribute.name()) + "' is " +
+                                                      attribute.value() +
+                                                      ", below the smallest normal double (2.2e-308); sizes are 0 or normal");
     if (value > 0.0 || (zero_allowed && value == 0.0)) return value;
     return error(line_of(attribute, element), "attribute '" + std::string(attribute.name()) + "' must be " +
                                                   (zero_allowed ? ">= 0" : "> 0") + ", found " + attribute.value());

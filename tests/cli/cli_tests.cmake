@@ -32,7 +32,6 @@ hbvh_cli_rejects(unknown_type.xml "unknown_type.xml:1: unknown volume type \"con
 hbvh_cli_rejects(missing_number.xml "missing_number.xml:1: .*pos")
 hbvh_cli_rejects(extra_number.xml "extra_number.xml:1: .*pos")
 hbvh_cli_rejects(not_a_number.xml "not_a_number.xml:1: .*pos")
-hbvh_cli_rejects(zero_size.xml "zero_size.xml:1: .*width")
 hbvh_cli_rejects(negative_size.xml "negative_size.xml:1: .*depth")
 hbvh_cli_rejects(negative_radius.xml "negative_radius.xml:1: .*radius")
 hbvh_cli_rejects(nan.xml "nan.xml:1: .*pos")
@@ -40,7 +39,6 @@ hbvh_cli_rejects(infinity.xml "infinity.xml:1: .*radius")
 hbvh_cli_rejects(not_rotation.xml "not_rotation.xml:1: attribute 'orientation' is not a rotation matrix")
 hbvh_cli_rejects(reflection.xml "reflection.xml:1: attribute 'orientation' is a reflection")
 hbvh_cli_rejects(empty.xml "empty.xml:1: file is empty")
-hbvh_cli_rejects(zero_radius.xml "zero_radius.xml:1: attribute .radius. must be > 0")
 hbvh_cli_rejects(no_volumes.xml "no_volumes.xml:1: ")
 hbvh_cli_rejects(unknown_attribute.xml "unknown_attribute.xml:1: unknown attribute 'colour'")
 hbvh_cli_rejects(wrong_root.xml "wrong_root.xml:1: expected <hierarchy>")
@@ -67,8 +65,9 @@ hbvh_cli_rejects_import(mesh_bad_header.ply "mesh_bad_header.ply:5: PLY header d
 # says why the piece was skipped.
 hbvh_cli_rejects_import(mesh_one_point_sphere.obj "mesh_one_point_sphere.obj: the file holds no collision primitives: .*mesh 'USP_point' is flat or a single point")
 
-# Degenerate but valid geometry: accepted, exit 0.
-foreach(input one_primitive duplicates flat_boxes mixed_scale)
+# Degenerate but valid geometry: accepted, exit 0. Zero sizes (a flat box, a point sphere) are valid primitives in
+# the library, so the XML that the writer makes of them reads back (refused until 2026-12-07).
+foreach(input one_primitive duplicates flat_boxes mixed_scale zero_size zero_radius)
   hbvh_cli_test(accepts.${input} 0 "" build ${HBVH_CLI_INPUTS}/${input}.xml -o ${HBVH_CLI_OUT}/${input}.out.xml)
 endforeach()
 

@@ -8,7 +8,9 @@
 #include <string>
 #include <vector>
 
+#include "hbvh/builders/build.hpp"
 #include "hbvh/scene/generate.hpp"
+#include "hbvh/tree/validate.hpp"
 
 namespace hbvh {
 namespace {
@@ -172,6 +174,23 @@ TEST(Xml, HierarchyRoundTrip) {
             return identity;
         }());
     }
+}
+
+TEST(Xml, ZeroSizesTheLibraryBuildsOverReadBack) {
+    // A point sphere, a flat box and a capsule of radius 0 are valid primitives: build() keeps them and the
+    // writer writes them, so the reader reads them (it refused sizes of 0 until 2026-12-07).
+    const std::vector<Primitive> primitives{{Sphere{Vec3(0, 0, 0), 0.0}, "point"},
+                                            {Obb{Vec3(2, 0, 0), Mat3::Identity(), Vec3(1, 1, 0)}, "flat"},
+                                            {Capsule{Vec3(4, 0, 0), Vec3(5, 0, 0), 0.0}, "segment"},
+                                            {Sphere{Vec3(6, 0, 0), 1.0}, "ball"}};
+    const Result<Bvh> built = build(primitives, Algorithm::automatic);
+    ASSERT_TRUE(built.has_value()) << built.error().to_string();
+    const XmlModel set = read_ok(write_primitives_xml(primitives));
+    ASSERT_EQ(set.primitives.size(), primitives.size());
+    for (std::size_t i = 0; i < primitives.size(); ++i) expect_same_primitive(primitives[i], set.primitives[i]);
+    const XmlModel tree = read_ok(write_xml(*built));
+    ASSERT_TRUE(tree.hierarchy.has_value());
+    EXPECT_TRUE(validate(*tree.hierarchy));
 }
 
 TEST(Xml, WrittenFormat) {
@@ -369,22 +388,22 @@ const BadInput bad_inputs[] = {
      "box corners overflow"},
     {"capsule overflow", H "  <volume type=\"capsule\" pos=\"-1.7e308 0 0\" direction=\"1e-300 0 0\" length=\"1.7e308\" radius=\"1\"/>\n</hierarchy>",
      2, "capsule ends overflow"},
-    {"zero radius", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"0\"/>\n</hierarchy>", 2,
-     "'radius' must be > 0, found 0"},
+    {"subnormal radius", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"1e-310\"/>\n</hierarchy>", 2,
+     "'radius' is 1e-310, below the smallest normal double"},
     {"box centre overflow", H "  <volume type=\"aabb\" pos=\"1e308 0 0\" width=\"1e308\" depth=\"1\" height=\"1\"/>\n</hierarchy>", 2,
      "overflow the range of double"},
     {"capsule length overflow", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"1 0 0\" length=\"1e200\" radius=\"1\"/>\n</hierarchy>",
      2, "overflow the range of double"},
     {"negative radius", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"1 0 0\" length=\"1\" radius=\"-1\"/>\n</hierarchy>",
-     2, "'radius' must be > 0"},
-    {"zero width", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"0\" depth=\"1\" height=\"1\"/>\n</hierarchy>", 2,
-     "'width' must be > 0"},
+     2, "'radius' must be >= 0"},
     {"text after the root", H "  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"1\"/>\n</hierarchy>\ngarbage\n", 4,
      "text after the end of the document's last tag"},
     {"rotated box thinner than doubles halve", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"5e-324\" depth=\"1\" height=\"1\"\n    orientation=\"1 0 0 0 0.8 -0.6 0 0.6 0.8\"/>\n</hierarchy>",
+     2, "'width' is 5e-324, below the smallest normal double"},
+    {"rotated box whose half is subnormal", H "  <volume type=\"obb\" pos=\"0 0 0\" width=\"3e-308\" depth=\"1\" height=\"1\"\n    orientation=\"1 0 0 0 0.8 -0.6 0 0.6 0.8\"/>\n</hierarchy>",
      2, "box sizes are too small: half of each must be a normal double"},
     {"negative depth", H "  <volume type=\"aabb\" pos=\"0 0 0\" width=\"1\" depth=\"-2\" height=\"1\"/>\n</hierarchy>", 2,
-     "'depth' must be > 0, found -2"},
+     "'depth' must be >= 0, found -2"},
     {"negative length", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"1 0 0\" length=\"-1\" radius=\"1\"/>\n</hierarchy>",
      2, "'length' must be >= 0"},
     {"zero direction", H "  <volume type=\"capsule\" pos=\"0 0 0\" direction=\"0 0 0\" length=\"1\" radius=\"1\"/>\n</hierarchy>",
@@ -402,7 +421,7 @@ const BadInput bad_inputs[] = {
      "exactly one top-level <volume>"},
     {"error deep inside", H "<volume type=\"sphere\" pos=\"0 0 0\" radius=\"9\">\n<volume type=\"sphere\" pos=\"0 0 0\" radius=\"9\">\n" SPHERE
                           "<volume type=\"sphere\" pos=\"0 0 0\" radius=\"-9\"/>\n</volume>\n</volume>\n</hierarchy>",
-     5, "'radius' must be > 0"},
+     5, "'radius' must be >= 0"},
 };
 #undef H
 #undef SPHERE

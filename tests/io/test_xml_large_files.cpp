@@ -64,7 +64,7 @@ TEST(XmlLargeFiles, LineAfterMultiLineAttributeValues) {
         "</hierarchy>\n";
     const Error error = read_error(text);
     EXPECT_EQ(error.line, 8) << error.to_string();
-    EXPECT_EQ(error.message, "attribute 'radius' must be > 0, found -1");
+    EXPECT_EQ(error.message, "attribute 'radius' must be >= 0, found -1");
 }
 
 TEST(XmlLargeFiles, NodeLinesAfterMultiLineAttributeValues) {
@@ -157,11 +157,11 @@ TEST(XmlLargeFiles, ProblemsOfStructureAndOfVolumesComeInDocumentOrder) {
     EXPECT_NE(box_first.message.find("unexpected element <box>"), std::string::npos);
     const Error volume_first = read_error(nested_file(large_count, 40000, "<box/>", 30000));
     EXPECT_EQ(volume_first.line, 30000 + 3) << volume_first.to_string();
-    EXPECT_EQ(volume_first.message, "attribute 'radius' must be > 0, found -1");
+    EXPECT_EQ(volume_first.message, "attribute 'radius' must be >= 0, found -1");
     // A bad volume holding the misplaced element: its own problem is met first.
     const Error same_volume = read_error(nested_file(large_count, 40000, "<box/>", 40000));
     EXPECT_EQ(same_volume.line, 40000 + 3) << same_volume.to_string();
-    EXPECT_EQ(same_volume.message, "attribute 'radius' must be > 0, found -1");
+    EXPECT_EQ(same_volume.message, "attribute 'radius' must be >= 0, found -1");
     // And the tree of a valid large file has a line for every node.
     const Result<XmlModel> valid = read_xml_string(nested_file(large_count, no_fault, "", no_fault), "nested.xml");
     ASSERT_TRUE(valid) << valid.error().to_string();
