@@ -21,6 +21,8 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/SVD>
+
 #include "hbvh/hbvh.hpp"
 
 namespace py = pybind11;
@@ -66,10 +68,41 @@ std::string shape_text(const py::array& array) {
     return text + (array.ndim() == 1 ? ",)" : ")");
 }
 
+/// `object` (an array or anything numpy makes one of) as C-contiguous doubles, when it holds integers or floats:
+/// forcecast alone also turned booleans, complex numbers (dropping the imaginary part), dates, strings and None
+/// into numbers, and read a masked array's hidden values.
+DoubleArray numbers_array(const py::handle& object, const char* name) {
+    const py::array raw = py::array::ensure(object);
+    if (!raw) throw py::value_error(std::string(name) + " must be an array of numbers");
+    const char kind = raw.dtype().kind();
+    if (kind != 'i' && kind != 'u' && kind != 'f')
+        throw py::value_error(std::string(name) + " must hold integers or floats, not dtype " +
+                              py::str(raw.dtype()).cast<std::string>());
+    if (py::hasattr(object, "mask"))
+        throw py::value_error(std::string(name) + " is a masked array: fill it first (numpy.ma.filled)");
+    return DoubleArray::ensure(raw);
+}
+
+/// Whether `object`'s numbers are floats narrower than double: a float32 rotation is off a rotation by its
+/// rounding (a few 1e-8), far beyond the library's 1e-9, and is replaced by the nearest one (nearest_rotation).
+bool narrow_floats(const py::handle& object) {
+    const py::array raw = py::array::ensure(object);
+    return raw && raw.dtype().kind() == 'f' && raw.dtype().itemsize() < 8;
+}
+
+/// The proper rotation nearest `m` (the orthogonal factor of its polar decomposition) when `m` is one up to
+/// single-precision rounding (|R^T R - I| <= 1e-5, det > 0); `m` itself otherwise, which validation then refuses
+/// in its own words.
+Mat3 nearest_rotation(const Mat3& m) {
+    if (!m.allFinite() || !((m.transpose() * m - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-5) || !(m.determinant() > 0.0))
+        return m;
+    const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    return svd.matrixU() * svd.matrixV().transpose();
+}
+
 /// `object` as a C-contiguous double array of shape `shape` (-1: any length, the same N for every argument).
 DoubleArray checked_array(const py::handle& object, const char* name, std::vector<py::ssize_t> shape, py::ssize_t& n) {
-    DoubleArray array = DoubleArray::ensure(object);
-    if (!array) throw py::value_error(std::string(name) + " must be an array of numbers");
+    DoubleArray array = numbers_array(object, name);
     bool ok = array.ndim() == static_cast<py::ssize_t>(shape.size());
     for (std::size_t i = 0; ok && i < shape.size(); ++i) {
         if (shape[i] >= 0) {
@@ -105,7 +138,7 @@ Mat3 mat3_at(const DoubleArray& array, py::ssize_t row) {
 
 /// Radii of shape (N,), or one number for all.
 std::vector<double> radii_of(const py::handle& object, py::ssize_t& n) {
-    DoubleArray array = DoubleArray::ensure(object);
+    DoubleArray array = numbers_array(object, "radii");
     if (array && array.ndim() == 0 && n >= 0) return std::vector<double>(static_cast<std::size_t>(n), *array.data());
     array = checked_array(object, "radii", {-1}, n);
     return {array.data(), array.data() + n};
@@ -133,14 +166,16 @@ Primitives make_boxes(const py::handle& centers_in, const py::handle& half_exten
     const DoubleArray half_extents = checked_array(half_extents_in, "half_extents", {-1, 3}, n);
     std::optional<DoubleArray> rotations;
     if (!rotations_in.is_none()) rotations = checked_array(rotations_in, "rotations", {-1, 3, 3}, n);
+    const bool round_rotations = !rotations_in.is_none() && narrow_floats(rotations_in);
     std::vector<std::string> names = names_of(names_in, n);
     std::vector<Primitive> items;
     items.reserve(static_cast<std::size_t>(n));
     for (py::ssize_t i = 0; i < n; ++i) {
         const Vec3 center = vec3_at(centers, i);
         const Vec3 half = vec3_at(half_extents, i);
+        const auto rotation = [&] { return round_rotations ? nearest_rotation(mat3_at(*rotations, i)) : mat3_at(*rotations, i); };
         // Without rotations a box is axis-aligned: an Aabb primitive, as in the survey's XML.
-        BoundingVolume volume = rotations ? BoundingVolume(Obb{center, mat3_at(*rotations, i), half})
+        BoundingVolume volume = rotations ? BoundingVolume(Obb{center, rotation(), half})
                                           : BoundingVolume(Aabb{center - half, center + half});
         items.push_back({std::move(volume), std::move(names[static_cast<std::size_t>(i)])});
     }
@@ -199,7 +234,8 @@ RigidTransform pose_of(const py::handle& object, const char* name) {
         const auto parts = object.cast<py::tuple>();
         const DoubleArray rotation = checked_array(parts[0], name, {3, 3}, unused);
         const DoubleArray translation = checked_array(parts[1], name, {3}, unused);
-        return {mat3_at(rotation, 0), vec3_at(translation, 0)};
+        const Mat3 r = mat3_at(rotation, 0);
+        return {narrow_floats(parts[0]) ? nearest_rotation(r) : r, vec3_at(translation, 0)};
     }
     const DoubleArray matrix = checked_array(object, name, {4, 4}, unused);
     const double* m = matrix.data();
@@ -210,6 +246,7 @@ RigidTransform pose_of(const py::handle& object, const char* name) {
         for (int c = 0; c < 3; ++c) pose.rotation(r, c) = m[4 * r + c];
         pose.translation(r) = m[4 * r + 3];
     }
+    if (narrow_floats(object)) pose.rotation = nearest_rotation(pose.rotation);
     return pose;
 }
 
@@ -331,11 +368,19 @@ void save(const Hierarchy& h, const std::string& path) {
 Result<VolumePolicy> with_type_weights(const py::object& weights, VolumePolicy policy) {
     if (weights.is_none()) return policy;
     if (py::isinstance<py::dict>(weights)) {
-        std::string list;
-        for (const auto& [kind, weight] : weights.cast<py::dict>())
-            list += (list.empty() ? "" : ",") + py::str(kind).cast<std::string>() + "=" +
-                    py::repr(py::float_(py::reinterpret_borrow<py::object>(weight))).cast<std::string>();
-        return parse_type_weights(list, policy);
+        // Each entry on its own: joined into one "kind=weight,..." text, a key such as "obb=50,sphere" added a
+        // weight of its own. An empty dict is no weights, as None.
+        for (const auto& [kind, weight] : weights.cast<py::dict>()) {
+            if (!py::isinstance<py::str>(kind)) throw py::value_error("type_weights keys must be BV kind names (str)");
+            const std::string name = kind.cast<std::string>();
+            if (name.find_first_of("=,@ \t\n") != std::string::npos)
+                return Error{"unknown BV type '" + name + "' in type_weights (aabb, obb, sphere or capsule)"};
+            Result<VolumePolicy> one = parse_type_weights(
+                name + "=" + py::repr(py::float_(py::reinterpret_borrow<py::object>(weight))).cast<std::string>(), policy);
+            if (!one) return one;
+            policy = one.value();
+        }
+        return policy;
     }
     if (!py::isinstance<py::str>(weights))
         throw py::value_error("type_weights must be a str ('obb=1.3,...' or '@FILE') or a dict, or None");
@@ -369,6 +414,11 @@ Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& al
     // As the CLI's warning: a tree of another builder than the one asked for is never silent.
     if (!report.substitution.empty() && PyErr_WarnEx(PyExc_UserWarning, report.substitution.c_str(), 1) != 0)
         throw py::error_already_set();  // the warning was turned into an error (warnings filter "error")
+    // A build stopped by time_limit returns a tree all the same (the best so far, or the two-level one): say so,
+    // as the CLI's --stats does, with the builder's own notes.
+    if (!report.time_limit.empty() &&
+        PyErr_WarnEx(PyExc_UserWarning, ("time_limit reached: " + report.time_limit).c_str(), 1) != 0)
+        throw py::error_already_set();
     return Hierarchy::from(std::move(built->value()));
 }
 
@@ -411,6 +461,7 @@ py::array_t<std::int64_t> collide_pair(const Hierarchy& a, const py::handle& pos
 py::list collide_many(const Hierarchy& a, const Hierarchy& b, const py::handle& poses_in, bool first) {
     py::ssize_t m = -1;
     const DoubleArray poses = checked_array(poses_in, "poses", {-1, 4, 4}, m);
+    const bool round_rotations = narrow_floats(poses_in);
     std::vector<RigidTransform> transforms(static_cast<std::size_t>(m));
     for (py::ssize_t k = 0; k < m; ++k) {
         const double* p = poses.data() + 16 * k;
@@ -420,6 +471,7 @@ py::list collide_many(const Hierarchy& a, const Hierarchy& b, const py::handle& 
             for (int c = 0; c < 3; ++c) transforms[static_cast<std::size_t>(k)].rotation(r, c) = p[4 * r + c];
             transforms[static_cast<std::size_t>(k)].translation(r) = p[4 * r + 3];
         }
+        if (round_rotations) transforms[static_cast<std::size_t>(k)].rotation = nearest_rotation(transforms[static_cast<std::size_t>(k)].rotation);
     }
     std::vector<CollideResult> results(transforms.size());
     {

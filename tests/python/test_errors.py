@@ -56,10 +56,19 @@ def test_bad_pose():
         hbvh.collide(tree, np.ones((4, 4)), tree, None)
 
 
+def cli_usage_message(cli, command, *args):
+    # Bad builder flags are usage errors: exit 2, "hbvh COMMAND: message".
+    result = run_cli(cli, command, *args)
+    assert result.returncode == 2, (result.returncode, result.stderr)
+    line = result.stderr.strip().splitlines()[-1]
+    assert line.startswith(f"hbvh {command}: ")
+    return line[len(f"hbvh {command}: "):]
+
+
 def test_bad_build_arguments_match_the_cli(cli):
     chair = hbvh.load(str(MODELS / "chair.xml"))
-    assert message_of(hbvh.build, chair, algorithm="nope") == cli_message(cli, "stats", MODELS / "chair.xml", "-a", "nope")
-    assert message_of(hbvh.build, chair, types="aabb,cone") == cli_message(
+    assert message_of(hbvh.build, chair, algorithm="nope") == cli_usage_message(cli, "stats", MODELS / "chair.xml", "-a", "nope")
+    assert message_of(hbvh.build, chair, types="aabb,cone") == cli_usage_message(
         cli, "stats", MODELS / "chair.xml", "--types", "aabb,cone")
     with pytest.raises(ValueError, match="time_limit"):
         hbvh.build(chair, time_limit=-1.0)
@@ -103,3 +112,49 @@ def test_damaged_binary_and_missing_files_match_the_cli(cli, tmp_path):
     unknown = tmp_path / "model.abc"
     unknown.write_text("x")
     assert message_of(hbvh.load, str(unknown)) == cli_message(cli, "stats", unknown)
+
+
+def test_only_integer_and_float_arrays_are_numbers():
+    # forcecast made numbers of booleans, complex numbers (imaginary part dropped), strings and None.
+    for bad, dtype in [(np.array([[True, False, True]]), "bool"), (np.array([[1 + 2j, 0, 0]]), "complex128"),
+                       (np.array([["1", "2", "3"]]), "<U1")]:
+        with pytest.raises(ValueError, match=f"centers must hold integers or floats, not dtype {dtype}"):
+            hbvh.spheres(bad, 1.0)
+    with pytest.raises(ValueError, match="radii must hold integers or floats, not dtype object"):
+        hbvh.spheres([[0, 0, 0]], None)
+    with pytest.raises(ValueError, match="masked array"):
+        hbvh.spheres(np.ma.masked_array([[1.0, 2, 3]], mask=[[1, 0, 0]]), 1.0)
+    # Integers are numbers.
+    assert hbvh.spheres(np.array([[1, 2, 3]]), 1).array["radius"][0] == 1.0
+
+
+def test_single_precision_rotations_are_the_nearest_rotation():
+    # float32 rounding leaves a rotation ~5e-8 off, beyond the library's 1e-9: such input was always refused.
+    c, s = np.cos(0.3), np.sin(0.3)
+    rotation = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    narrow = hbvh.boxes(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32), rotation[None].astype(np.float32))
+    wide = hbvh.boxes(np.zeros((1, 3)), np.ones((1, 3)), rotation[None])
+    assert np.abs(narrow.array["rotation"] - wide.array["rotation"]).max() < 1e-6
+    tree = hbvh.build(hbvh.spheres([[0, 0, 0], [3, 0, 0]], 1.0))
+    pose = np.eye(4)
+    pose[:3, :3], pose[0, 3] = rotation, 1.5
+    expected = hbvh.collide(tree, None, tree, pose).tolist()
+    assert hbvh.collide(tree, None, tree, pose.astype(np.float32)).tolist() == expected
+    assert hbvh.collide(tree, None, tree, (rotation.astype(np.float32), pose[:3, 3])).tolist() == expected
+    assert [p.tolist() for p in hbvh.collide_many(tree, tree, pose[None].astype(np.float32))] == [expected]
+    # A float32 matrix that is no rotation is still refused.
+    with pytest.raises(hbvh.Error, match="rotation"):
+        hbvh.boxes(np.zeros((1, 3), np.float32), np.ones((1, 3)), (1.01 * rotation)[None].astype(np.float32))
+
+
+def test_type_weights_dict_entries_are_each_a_kind():
+    chair = hbvh.load(str(MODELS / "chair.xml"))
+    with pytest.raises(hbvh.Error, match="unknown BV type 'obb=50,sphere'"):
+        hbvh.build(chair, type_weights={"obb=50,sphere": 1.0})
+    assert hbvh.build(chair, type_weights={}).cost == hbvh.build(chair).cost
+
+
+def test_a_build_the_time_limit_stopped_warns():
+    chair = hbvh.load(str(MODELS / "chair.xml"))
+    with pytest.warns(UserWarning, match="time_limit reached: optimal: time limit reached"):
+        hbvh.build(chair, algorithm="optimal", time_limit=1e-9)

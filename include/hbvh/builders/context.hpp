@@ -55,6 +55,7 @@ struct BuildContext {
     void note_deadline(const std::string& what) const {
         if (report == nullptr) return;
         report->budget_hit = true;
+        if (report->time_limit.empty()) report->time_limit = what;
         report->notes.push_back(what);
     }
 };

@@ -31,6 +31,9 @@ struct BuildReport {
     /// Why, when built_by is set: one sentence the CLI prints as a warning and Python raises as a UserWarning, so
     /// that a substituted tree is never silent (it is among the notes too).
     std::string substitution;
+    /// The first note of a builder the time limit stopped (BuildContext::note_deadline), empty when none was: the
+    /// tree returned is the best found by then. Python warns with it, as it does for `substitution`.
+    std::string time_limit;
 };
 
 }  // namespace hbvh
