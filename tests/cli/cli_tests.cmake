@@ -195,6 +195,11 @@ hbvh_cli_test(quality.excludes_algorithm 2 "excludes" build ${PROJECT_SOURCE_DIR
 hbvh_cli_test(quality.unknown 2 "slow not in" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --quality slow
               -o ${HBVH_CLI_OUT}/quality_unknown.xml)
 
+# Builder flags in every command that builds, simulate's report, and calibrate's weights through a pipe.
+add_test(NAME cli.builder_flags
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}
+                 -P ${CMAKE_CURRENT_LIST_DIR}/builder_flags.cmake)
+
 # stats weighs its cost by --type-weight, as build --stats does.
 add_test(NAME cli.stats_type_weight
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}

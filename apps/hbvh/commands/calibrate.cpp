@@ -13,6 +13,9 @@
 // trees slower (docs/metrics.md, "Per-kind weights"), so the table of pairs is written for the record only.
 #include <fmt/core.h>
 
+#include <cstdio>
+#include <filesystem>
+
 #include <algorithm>
 #include <array>
 #include <span>
@@ -79,6 +82,16 @@ std::string weights_file(const PairTable& pair_ns, const std::string& weights) {
 }
 
 int run_calibrate(const CalibrateArguments& args) {
+    // An output that cannot be written is said before the minute of measuring, not after it.
+    if (!args.output.empty() && args.output != "-") {
+        const std::filesystem::path output(args.output);
+        const std::filesystem::path folder = output.parent_path().empty() ? "." : output.parent_path();
+        std::error_code ignored;
+        if (!std::filesystem::is_directory(folder, ignored))
+            return report_error(Error{"cannot write: the folder " + folder.string() + " does not exist", args.output});
+        if (std::filesystem::is_directory(output, ignored))
+            return report_error(Error{"is a directory, not a file: give the output a file name", args.output});
+    }
     const std::vector<Primitive> scene = generate_scene({.count = args.primitives, .seed = 11});
     const Result<Bvh> flat = build(scene, Algorithm::two_level);
     if (!flat) return report_error(flat.error());
@@ -112,23 +125,26 @@ int run_calibrate(const CalibrateArguments& args) {
         return pair_ns[index][index];
     };
     const double aabb = self_ns(BvType::aabb);
-    fmt::print("ns per inner-node test (row: this tree's kind, column: the other tree's)\n{}",
+    // With -o - the weights file is standard output, so that it pipes into --type-weight @/dev/stdin: the table
+    // then goes to standard error.
+    std::FILE* const table = args.output == "-" ? stderr : stdout;
+    fmt::print(table, "ns per inner-node test (row: this tree's kind, column: the other tree's)\n{}",
                pair_table_text(pair_ns, ""));
     std::string weights;
-    fmt::print("\n{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
+    fmt::print(table, "\n{:<8} {:>12} {:>8}\n", "kind", "ns per test", "weight");
     for (BvType type : all_bv_types) {
         const double ns = self_ns(type);  // against its own kind
         // A kind whose share could not be told from the noise (0 after the leaf tests) keeps weight 1; the floor
         // keeps every weight one that --type-weight accepts (positive at the printed precision).
         const double weight = aabb > 0.0 && ns > 0.0 ? std::max(ns / aabb, 0.001) : 1.0;
-        fmt::print("{:<8} {:>12.2f} {:>8.3f}\n", to_string(type), ns, weight);
+        fmt::print(table, "{:<8} {:>12.2f} {:>8.3f}\n", to_string(type), ns, weight);
         weights += fmt::format("{}{}={:.3f}", weights.empty() ? "" : ",", to_string(type), weight);
     }
-    fmt::print("{:<8} {:>12.2f}   (primitive test, for reference)\n", "leaf", 1e9 * leaf_seconds);
+    fmt::print(table, "{:<8} {:>12.2f}   (primitive test, for reference)\n", "leaf", 1e9 * leaf_seconds);
     if (!args.output.empty()) {
         if (Status written = write_output(args.output, weights_file(pair_ns, weights)); !written)
             return report_error(written.error());
-        if (args.output != "-") fmt::print("weights written to {} (use: --type-weight @{})\n", args.output, args.output);
+        if (args.output != "-") fmt::print(table, "weights written to {} (use: --type-weight @{})\n", args.output, args.output);
     }
     return exit_ok;
 }

@@ -58,6 +58,8 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
 }
 
 int run_collide(const CollideArguments& args) {
+    const std::optional<BuildRequest> request = resolve_or_report(args.builder, "collide");
+    if (!request) return exit_bad_usage;
     Result<RigidTransform> pose_a = args.pose_a ? parse_pose(*args.pose_a, "--pose-a") : Result<RigidTransform>(RigidTransform{});
     Result<RigidTransform> pose_b = args.pose_b ? parse_pose(*args.pose_b, "--pose-b") : Result<RigidTransform>(RigidTransform{});
     for (const Result<RigidTransform>* pose : {&pose_a, &pose_b})
@@ -69,9 +71,9 @@ int run_collide(const CollideArguments& args) {
     if (!model_a) return report_error(model_a.error());
     Result<Model> model_b = load_model(args.input_b);
     if (!model_b) return report_error(model_b.error());
-    Result<Bvh> bvh_a = hierarchy_of(model_a.value(), args.builder);
+    Result<Bvh> bvh_a = hierarchy_of(model_a.value(), *request, args.builder);
     if (!bvh_a) return report_error(bvh_a.error());
-    Result<Bvh> bvh_b = hierarchy_of(model_b.value(), args.builder);
+    Result<Bvh> bvh_b = hierarchy_of(model_b.value(), *request, args.builder);
     if (!bvh_b) return report_error(bvh_b.error());
 
     const CollideResult result = collide(bvh_a.value(), pose_a.value(), bvh_b.value(), pose_b.value(),

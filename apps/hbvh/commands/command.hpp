@@ -7,6 +7,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "hbvh/builders/build.hpp"
@@ -50,11 +51,11 @@ struct Model : ModelFile {
 int report_error(const Error& error);
 /// Prints warnings to stderr, one a line.
 void report_warnings(const std::vector<std::string>& warnings);
-/// Refuses what is not a decimal integer from 0 to 2^64 - 1 (CLI11 alone wraps "-1" and clamps larger values, so
-/// different seeds on the command line gave the same scene).
 /// Accepts a whole number from `least` to `most` and names both in its refusal ("'abc' is not a whole number from 1
 /// to 1000"), where CLI::Range says "not in range" of a word that is no number at all.
 [[nodiscard]] CLI::Validator whole_number(std::uint64_t least, std::uint64_t most);
+/// Refuses what is not a decimal integer from 0 to 2^64 - 1 (CLI11 alone wraps "-1" and clamps larger values, so
+/// different seeds on the command line gave the same scene).
 [[nodiscard]] CLI::Validator seed_validator();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.
@@ -90,12 +91,22 @@ struct BuilderFlags {
     void add_refit_to(CLI::App& command);
     /// The build these flags ask for, or a usage Error.
     [[nodiscard]] Result<BuildRequest> resolve() const;
+    /// Whether any flag that chooses or steers a build differs from its default (a stored hierarchy ignores them).
+    [[nodiscard]] bool steer_a_build() const;
 };
+
+/// The build `flags` ask for, resolved once (a --type-weight @FILE is read once: it may be a pipe); nothing, after
+/// "hbvh COMMAND: problem" on stderr, when they cannot be (the caller then exits with exit_bad_usage). Called
+/// before any input is read, whatever the inputs turn out to hold, so that a bad flag is a usage error in every
+/// command (it was exit 1 in those that build only when given a primitive set).
+[[nodiscard]] std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::string_view command);
 
 /// The model's stored hierarchy once it passes validate() (with flags.refit, its non-enclosing volumes
 /// refitted and a note printed), or one built from its primitives with `flags`. A stored hierarchy that
 /// fails is refused with "file:line: volume (obb) does not enclose primitive N ('name') by D".
 [[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags);
+/// As above, building a primitive set with `request` (resolve_or_report's) instead of resolving `flags` again.
+[[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuildRequest& request, const BuilderFlags& flags);
 /// Ok when the model has no stored hierarchy or its volumes enclose their primitives (or flags.refit, after
 /// a note); for build, which rebuilds from the primitives but must not pass over a broken file in silence.
 [[nodiscard]] Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags);

@@ -184,11 +184,37 @@ Status check_stored_hierarchy(const Model& model, const BuilderFlags& flags) {
     return Ok{};
 }
 
+bool BuilderFlags::steer_a_build() const {
+    const BuilderFlags defaults;
+    return algorithm != defaults.algorithm || quality != defaults.quality || types != defaults.types ||
+           type_weights != defaults.type_weights || objective != defaults.objective || refine != defaults.refine ||
+           treelet_units != defaults.treelet_units || time_limit_seconds != defaults.time_limit_seconds;
+}
+
+std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::string_view command) {
+    Result<BuildRequest> request = flags.resolve();
+    if (request) return std::move(request.value());
+    fmt::print(stderr, "hbvh {}: {}\n", command, request.error().to_string());
+    return std::nullopt;
+}
+
 Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags) {
-    if (model.hierarchy) return checked_stored_hierarchy(model, flags);
+    if (model.hierarchy) return hierarchy_of(model, BuildRequest{}, flags);
     Result<BuildRequest> request = flags.resolve();
     if (!request) return request.error();
     return request->run(model.primitives);
+}
+
+Result<Bvh> hierarchy_of(const Model& model, const BuildRequest& request, const BuilderFlags& flags) {
+    if (model.hierarchy) {
+        if (flags.steer_a_build())
+            fmt::print(stderr, "hbvh: warning: {} stores a hierarchy, which is used as it is: the flags that choose and "
+                               "steer a build (-a, --quality, --types, --type-weight, --objective, --refine, "
+                               "--treelet-units, --time-limit) apply to primitive sets\n",
+                       model.source);
+        return checked_stored_hierarchy(model, flags);
+    }
+    return request.run(model.primitives);
 }
 
 }  // namespace hbvh::cli

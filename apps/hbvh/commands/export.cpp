@@ -85,6 +85,8 @@ Result<std::string> render_svg(const std::string& dot_text) {
 }
 
 int run_export(const ExportArguments& args) {
+    const std::optional<BuildRequest> request = resolve_or_report(args.builder, "export");
+    if (!request) return exit_bad_usage;
     Result<std::string> format = export_format(args);
     if (!format) {
         report_error(format.error());
@@ -93,7 +95,7 @@ int run_export(const ExportArguments& args) {
     Result<Model> model = load_model(args.input, args.input_format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
-    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    Result<Bvh> bvh = hierarchy_of(model.value(), *request, args.builder);
     if (!bvh) return report_error(bvh.error());
 
     std::string content;

@@ -27,14 +27,21 @@ nlohmann::json to_json(const QueryStats& stats) {
 }
 
 int run_simulate(SimulateArguments args) {
+    const std::optional<BuildRequest> request = resolve_or_report(args.builder, "simulate");
+    if (!request) return exit_bad_usage;
     Result<Model> model = load_model(args.input);
     if (!model) return report_error(model.error());
-    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    Result<Bvh> bvh = hierarchy_of(model.value(), *request, args.builder);
     if (!bvh) return report_error(bvh.error());
     if (args.two_level_query) args.options.method = QueryMethod::two_level;
     const SimulationResult result = simulate(bvh.value(), args.options);
     if (args.json) {
-        const nlohmann::json out{{"model", args.input},         {"algorithm", args.builder.algorithm},
+        // The builder that made the tree (--quality's preset included), or "stored" for a file's own hierarchy;
+        // and which query ran.
+        const std::string made_by =
+            model->hierarchy ? std::string("stored") : std::string(to_string(request->algorithm));
+        const nlohmann::json out{{"model", args.input},         {"algorithm", made_by},
+                                 {"query", args.two_level_query ? "two-level" : "tandem"},
                                  {"moving", to_json(result.moving)}, {"total", to_json(result.total)},
                                  {"steps", result.steps},       {"restarts", result.restarts},
                                  {"complete", result.complete}};

@@ -68,15 +68,19 @@ nlohmann::ordered_json violations_json(const Model& model, const Bvh& bvh,
 }
 
 int run_stats(const StatsArguments& args) {
+    const std::optional<BuildRequest> request = resolve_or_report(args.builder, "stats");
+    if (!request) return exit_bad_usage;
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
-    Result<BuildRequest> request = args.builder.resolve();
-    if (!request) {
-        fmt::print(stderr, "hbvh stats: {}\n", request.error().to_string());
-        return exit_bad_usage;
-    }
-    // A stored hierarchy is measured as it is, violations and all: stats is how a user checks a file.
+    // A stored hierarchy is measured as it is, violations and all: stats is how a user checks a file. Only
+    // --type-weight (which weighs the cost) applies to it.
+    BuilderFlags building = args.builder;
+    building.type_weights.clear();
+    if (model->hierarchy && building.steer_a_build())
+        fmt::print(stderr, "hbvh: warning: {} stores a hierarchy, which is measured as it is: -a, --quality, --types, "
+                           "--objective, --refine, --treelet-units and --time-limit apply to primitive sets\n",
+                   model->source);
     Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : request->run(model->primitives);
     if (!bvh) return report_error(bvh.error());
     const std::vector<ContainmentViolation> violations = containment_violations(bvh.value());

@@ -28,10 +28,12 @@ int run_view(const ViewArguments& args) {
                            "SVG use `hbvh export`)\n", args.output);
         return exit_bad_usage;
     }
+    const std::optional<BuildRequest> request = resolve_or_report(args.builder, "view");
+    if (!request) return exit_bad_usage;
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
     report_warnings(model->warnings);
-    Result<Bvh> bvh = hierarchy_of(model.value(), args.builder);
+    Result<Bvh> bvh = hierarchy_of(model.value(), *request, args.builder);
     if (!bvh) return report_error(bvh.error());
     // Default title: the input's file name, which is what a user has open in several tabs.
     const std::string title = !args.title.empty()    ? args.title
