@@ -150,6 +150,7 @@ hbvh_cli_bad_pose(inf --pose-a "0 inf 0" ": 'inf' is not a finite number")
 hbvh_cli_bad_pose(inf_quaternion --pose-b "0 0 0 1 -inf 0 0" ": '-inf' is not a finite number")
 hbvh_cli_bad_pose(overflow --pose-b "1e999 0 0" ": '1e999' is out of the range of double")
 hbvh_cli_bad_pose(hex --pose-b "0x1 0 0" ": '0x1' is not a finite number")
+hbvh_cli_test(collide.pose.leading_plus 0 "" collide ${HBVH_CLI_PAIRS} ${HBVH_CLI_PAIRS} --pose-b "+1 0 0")
 hbvh_cli_test(collide.pose.large_quaternion 0 "" collide ${HBVH_CLI_PAIRS} ${HBVH_CLI_PAIRS}
               --pose-b "0 0 0 0 1e300 1e300 0")
 hbvh_cli_bad_pose(not_a_number --pose-a "0 0 x" ": 'x' is not a finite number")
@@ -209,6 +210,15 @@ add_test(NAME cli.stats_type_weight
 add_test(NAME cli.format_importer_on_binary
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}
                  -P ${CMAKE_CURRENT_LIST_DIR}/format_on_binary.cmake)
+
+# export: --format may not contradict an extension of another export format, an extension tells in any case, and a
+# format's own flags are refused with another.
+hbvh_cli_test(export.format_contradicts_extension 2 "--format dot contradicts the output's extension .gltf" export
+              ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a fast --format dot -o ${HBVH_CLI_OUT}/contradicted.gltf)
+hbvh_cli_test(export.upper_case_extension 0 "" export ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a fast
+              -o ${HBVH_CLI_OUT}/upper.GLTF)
+hbvh_cli_test(export.overlay_is_gltfs 2 "--overlay is for glTF output, not dot" export
+              ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a fast --overlay -o ${HBVH_CLI_OUT}/overlay.dot)
 
 # view writes HTML: an output named for another format is a usage error, before anything is built or written.
 hbvh_cli_test(view.not_html 2 "is not named .html" view ${PROJECT_SOURCE_DIR}/data/models/chair.xml

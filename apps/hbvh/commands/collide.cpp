@@ -7,6 +7,7 @@
 #include <cmath>
 #include <optional>
 #include <sstream>
+#include <string_view>
 
 #include "commands/command.hpp"
 #include "hbvh/geometry/validation.hpp"
@@ -32,11 +33,14 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
     while (stream >> word) {
         // from_chars, as the XML reader parses numbers: decimal only (no hex, no locale), and a value too small
         // for a double reads as out of range rather than failing as "not a number".
+        // A leading '+', which from_chars refuses, is accepted as the XML reader accepts it (not before a sign).
+        std::string_view digits = word;
+        if (digits.size() > 1 && digits.front() == '+' && digits[1] != '+' && digits[1] != '-') digits.remove_prefix(1);
         double value = 0.0;
-        const auto [end, code] = std::from_chars(word.data(), word.data() + word.size(), value);
+        const auto [end, code] = std::from_chars(digits.data(), digits.data() + digits.size(), value);
         if (code == std::errc::result_out_of_range)
             return Error{std::string(flag) + ": '" + word + "' is out of the range of double"};
-        if (code != std::errc{} || end != word.data() + word.size() || !std::isfinite(value))
+        if (code != std::errc{} || end != digits.data() + digits.size() || !std::isfinite(value))
             return Error{std::string(flag) + ": '" + word + "' is not a finite number"};
         numbers.push_back(value);
     }

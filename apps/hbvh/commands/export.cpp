@@ -27,16 +27,24 @@ struct ExportArguments {
     bool no_carry = false;
 };
 
-/// The export format: --format when given, else the output's extension.
+/// The export format: --format when given, else the output's extension (in any case). A --format that contradicts
+/// an extension naming another export format is refused: DOT written into x.gltf was taken for glTF later. The
+/// flags of one format are refused with another (--overlay is glTF's, --no-carry DOT's and SVG's).
 Result<std::string> export_format(const ExportArguments& args) {
-    std::string format = args.format;
-    if (format.empty()) {
-        format = std::filesystem::path(args.output).extension().string();
-        if (!format.empty()) format.erase(0, 1);
+    std::string extension = lower_case_extension(args.output);
+    if (!extension.empty()) extension.erase(0, 1);
+    const auto known = [](const std::string& name) { return name == "gltf" || name == "dot" || name == "svg"; };
+    if (!args.format.empty() && known(extension) && args.format != extension)
+        return Error{"--format " + args.format + " contradicts the output's extension ." + extension +
+                     ": name the output ." + args.format + ", or leave --format out"};
+    const std::string format = args.format.empty() ? extension : args.format;
+    if (!known(format)) {
+        if (format.empty()) return Error{"cannot tell the format of '" + args.output + "': use .gltf, .dot or .svg, or --format"};
+        return Error{"unknown export format '" + format + "' (gltf, dot or svg)"};
     }
-    if (format == "gltf" || format == "dot" || format == "svg") return format;
-    if (format.empty()) return Error{"cannot tell the format of '" + args.output + "': use .gltf, .dot or .svg, or --format"};
-    return Error{"unknown export format '" + format + "' (gltf, dot or svg)"};
+    if (args.overlay && format != "gltf") return Error{"--overlay is for glTF output, not " + format};
+    if (args.no_carry && format == "gltf") return Error{"--no-carry is for DOT and SVG output, not glTF"};
+    return format;
 }
 
 /// The full path of `program` on PATH, or empty when it is not there.
