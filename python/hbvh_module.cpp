@@ -524,10 +524,14 @@ PYBIND11_MODULE(hbvh, m) {
     py::class_<Hierarchy>(m, "Hierarchy", "A bounding volume hierarchy with its query layout.")
         .def_property_readonly("cost", [](const Hierarchy& h) { return hbvh::cost(h.bvh); }, "Eq. 2 of the survey.")
         .def("stats", &stats_dict, "The measures of `hbvh stats --json`, as a dict.")
-        .def("save", &save, "path"_a, "Writes the survey XML, or the binary format for a .hbvh name (atomically).")
+        .def("save", &save, "path"_a,
+             "Writes the survey XML, or the binary format for a .hbvh name (atomically). A .hbvh keeps the primitives' "
+             "order; XML lists them in the tree's order (its leaves are the primitives), so after load() a pair's "
+             "indices refer to that order.")
         .def_property_readonly("nodes", [](const Hierarchy& h) { return node_array(h.bvh); },
-                               "Structured array, root first, breadth-first: type, first_child, child_count, "
-                               "primitive (leaves), center, rotation, half_extents, radius, p0, p1.")
+                               "Structured array, root first, breadth-first: type (0 aabb, 1 obb, 2 sphere, 3 "
+                               "capsule), first_child and child_count (0 for a leaf), primitive (a leaf's input index; "
+                               "0, meaning nothing, on inner nodes), center, rotation, half_extents, radius, p0, p1.")
         .def_property_readonly("primitives", [](const Hierarchy& h) { return Primitives{h.bvh.primitives, {}}; })
         .def("__len__", [](const Hierarchy& h) { return h.bvh.nodes.size(); })
         .def("__repr__", [](const Hierarchy& h) {
