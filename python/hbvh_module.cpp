@@ -6,6 +6,7 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
+#include <pybind11/stl/filesystem.h>
 
 #include <algorithm>
 #include <cstddef>
@@ -343,7 +344,9 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
 // Stage 3: files, as the CLI reads them (read_model_file; then the CLI's load_model checks).
 
 /// Primitives or a Hierarchy from any file the CLI reads. `format` as the CLI's --format.
-py::object load(const std::string& path, const std::string& format, bool refit) {
+/// Paths are str or os.PathLike (pathlib.Path), as open() takes them.
+py::object load(const std::filesystem::path& file, const std::string& format, bool refit) {
+    const std::string path = file.string();
     Result<ModelFile> read = read_model_file(path, format);
     if (!read) raise(read.error());
     // The checks of the CLI's load_model, then the containment check every CLI command but stats makes.
@@ -355,7 +358,8 @@ py::object load(const std::string& path, const std::string& format, bool refit) 
     return py::cast(Hierarchy::from(std::move(enclosing).value(), std::move(read->node_lines)));
 }
 
-void save(const Hierarchy& h, const std::string& path) {
+void save(const Hierarchy& h, const std::filesystem::path& file) {
+    const std::string path = file.string();
     const Status written = lower_case_extension(path) == ".hbvh" ? write_binary_file(path, h.bvh)
                                                                   : write_file_atomic(path, write_xml(h.bvh));
     if (!written) raise(written.error());

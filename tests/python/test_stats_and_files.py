@@ -115,3 +115,10 @@ def test_type_weights_are_the_clis_in_every_form(cli, tmp_path):
         hbvh.build(primitives, "split", type_weights="@" + str(bad))
     with pytest.raises(hbvh.Error, match="unknown bounding-volume type"):
         hbvh.build(primitives, "split", type_weights={"cone": 2.0})
+
+
+def test_paths_may_be_pathlib_paths(tmp_path):
+    chair = hbvh.load(MODELS / "chair.xml")          # a pathlib.Path, as open() takes
+    tree = hbvh.build(chair, algorithm="split")
+    tree.save(tmp_path / "chair.hbvh")
+    assert hbvh.load(tmp_path / "chair.hbvh").cost == tree.cost
