@@ -10,22 +10,28 @@ namespace {
 // Below this length a direction carries no information; MuJoCo uses a similar cut-off (mjMINVAL).
 constexpr double tiny_length = 1e-14;
 
-// Lengths are taken with Eigen's stableNorm, which scales before it squares: a quaternion or axis of 1e160 parts
-// is as valid as one of 1 (the parts are finite), and a plain norm() overflowed there to infinity, which divided
-// every part to 0 (the identity, or a matrix that is no rotation).
+/// The length of `v`: the plain norm where its square neither overflows nor underflows (the same bits as always),
+/// else Eigen's stableNorm, which scales before it squares: a quaternion or axis of 1e160 parts is as valid as one
+/// of 1, and the plain norm overflowed there to infinity, which divided every part to 0 (the identity, or a
+/// matrix that is no rotation).
+template <class Vector>
+double length_of(const Vector& v) {
+    const double plain = v.norm();
+    return std::isfinite(plain) && plain > 1e-150 ? plain : v.stableNorm();
+}
 
 }  // namespace
 
 std::optional<Mat3> rotation_from_quat(double w, double x, double y, double z) {
     Eigen::Quaterniond q(w, x, y, z);
-    const double length = q.coeffs().stableNorm();
+    const double length = length_of(q.coeffs());
     if (length < tiny_length) return std::nullopt;
     q.coeffs() /= length;
     return q.toRotationMatrix();
 }
 
 std::optional<Mat3> rotation_from_axis_angle(const Vec3& axis, double angle) {
-    const double length = axis.stableNorm();
+    const double length = length_of(axis);
     if (length < tiny_length) return std::nullopt;
     return Eigen::AngleAxisd(angle, axis / length).toRotationMatrix();
 }
@@ -51,12 +57,12 @@ std::optional<Mat3> rotation_from_euler(const Vec3& angles, std::string_view seq
 }
 
 std::optional<Mat3> rotation_from_xy_axes(const Vec3& x, const Vec3& y) {
-    const double x_length = x.stableNorm();
+    const double x_length = length_of(x);
     if (x_length < tiny_length) return std::nullopt;
     const Vec3 x_unit = x / x_length;
     // Gram-Schmidt: only the part of y orthogonal to x counts, as in MuJoCo.
     const Vec3 y_orthogonal = y - x_unit.dot(y) * x_unit;
-    const double y_length = y_orthogonal.stableNorm();
+    const double y_length = length_of(y_orthogonal);
     if (y_length < tiny_length) return std::nullopt;
     Mat3 rotation;
     rotation.col(0) = x_unit;
@@ -66,7 +72,7 @@ std::optional<Mat3> rotation_from_xy_axes(const Vec3& x, const Vec3& y) {
 }
 
 std::optional<Mat3> rotation_from_z_axis(const Vec3& z) {
-    const double length = z.stableNorm();
+    const double length = length_of(z);
     if (length < tiny_length) return std::nullopt;
     const Vec3 direction = z / length;
     const Vec3 axis = Vec3::UnitZ().cross(direction);

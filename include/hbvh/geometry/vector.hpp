@@ -33,9 +33,10 @@ struct RigidTransform {
     [[nodiscard]] static RigidTransform from_quaternion(double w, double x, double y, double z,
                                                         const Vec3& translation = Vec3::Zero()) {
         const Eigen::Quaterniond q(w, x, y, z);
-        // Scaled before it is squared (stableNorm): components of 1e300 or 1e-300 overflowed or underflowed the
-        // plain norm, and such a quaternion came out refused as non-finite.
-        const double norm = q.coeffs().stableNorm();
+        // Where the plain norm's square overflows or underflows (components of 1e300 or 1e-300, which came out
+        // refused as non-finite), the norm is scaled before it squares (stableNorm); elsewhere it is the plain one.
+        const double plain = q.norm();
+        const double norm = std::isfinite(plain) && plain > 1e-150 ? plain : q.coeffs().stableNorm();
         if (!(norm > 0.0) || !std::isfinite(norm))
             return {Mat3::Constant(std::numeric_limits<double>::quiet_NaN()), translation};
         return {Eigen::Quaterniond(q.coeffs() / norm).toRotationMatrix(), translation};
