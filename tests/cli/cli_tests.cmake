@@ -220,6 +220,10 @@ hbvh_cli_test(export.upper_case_extension 0 "" export ${PROJECT_SOURCE_DIR}/data
 hbvh_cli_test(export.overlay_is_gltfs 2 "--overlay is for glTF output, not dot" export
               ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a fast --overlay -o ${HBVH_CLI_OUT}/overlay.dot)
 
+# build, convert and generate write survey XML (or .hbvh): an output named for another format is a usage error.
+hbvh_cli_test(generate.output_of_another_format 2 "names another format \\(.gltf\\)" generate --count 3
+              -o ${HBVH_CLI_OUT}/generated.gltf)
+
 # view writes HTML: an output named for another format is a usage error, before anything is built or written.
 hbvh_cli_test(view.not_html 2 "is not named .html" view ${PROJECT_SOURCE_DIR}/data/models/chair.xml
               -o ${HBVH_CLI_OUT}/view.gltf)

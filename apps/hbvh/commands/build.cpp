@@ -117,7 +117,9 @@ void add_build_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<BuildArguments>();
     CLI::App* sub = app.add_subcommand("build", "Build a hierarchy over a set of primitives");
     sub->add_option("input", args->input, "Primitive file (survey XML, MJCF, URDF, mesh), or - for stdin")->required();
-    sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML; .hbvh: binary), or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML; .hbvh: binary), or - for stdout")
+        ->capture_default_str()
+        ->check(hierarchy_output_name());
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);

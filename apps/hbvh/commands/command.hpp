@@ -57,6 +57,9 @@ void report_warnings(const std::vector<std::string>& warnings);
 /// Refuses what is not a decimal integer from 0 to 2^64 - 1 (CLI11 alone wraps "-1" and clamps larger values, so
 /// different seeds on the command line gave the same scene).
 [[nodiscard]] CLI::Validator seed_validator();
+/// Refuses an output name whose extension is another format's (.gltf, .obj, .dot, .html, .urdf, ...) for the
+/// commands that write survey XML or, for .hbvh, the binary format: XML written into x.gltf was read as glTF later.
+[[nodiscard]] CLI::Validator hierarchy_output_name();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.
 struct BuildRequest {

@@ -77,6 +77,20 @@ CLI::Validator whole_number(std::uint64_t least, std::uint64_t most) {
         "[" + std::to_string(least) + " - " + std::to_string(most) + "]");
 }
 
+CLI::Validator hierarchy_output_name() {
+    return CLI::Validator(
+        [](const std::string& name) {
+            static constexpr std::string_view others[] = {".gltf", ".glb", ".obj", ".stl", ".ply", ".fbx", ".dae",
+                                                          ".dot", ".svg", ".html", ".htm", ".urdf", ".json"};
+            const std::string extension = lower_case_extension(name);
+            if (std::find(std::begin(others), std::end(others), extension) == std::end(others)) return std::string();
+            return "'" + name + "' names another format (" + extension +
+                   "): this command writes survey XML, or the binary format for a .hbvh name (glTF, DOT, SVG: "
+                   "hbvh export; HTML: hbvh view)";
+        },
+        "OUTPUT");
+}
+
 CLI::Validator seed_validator() { return whole_number(0, std::numeric_limits<std::uint64_t>::max()); }
 
 int report_error(const Error& error) {

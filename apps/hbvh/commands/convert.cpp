@@ -19,7 +19,9 @@ void add_convert_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<ConvertArguments>();
     CLI::App* sub = app.add_subcommand("convert", "Convert MJCF, URDF or a mesh (UBX_/USP_/UCP_/UCX_) to survey XML");
     sub->add_option("input", args->input, "Input file (.xml MJCF or survey, .urdf, .gltf/.glb/.obj/.fbx/.dae)")->required();
-    sub->add_option("-o,--output", args->output, "Output survey XML (.hbvh: binary), or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", args->output, "Output survey XML (.hbvh: binary), or - for stdout")
+        ->capture_default_str()
+        ->check(hierarchy_output_name());
     sub->add_option("--format", args->format, "hbvh, xml, mjcf, urdf or mesh, when the extension does not tell; mesh-nodes: a plain mesh, one fitted primitive per mesh node");
     args->checks.add_refit_to(*sub);
     sub->footer("Example: hbvh convert robot.urdf -o robot.xml");

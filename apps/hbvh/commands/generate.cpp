@@ -16,7 +16,9 @@ void add_generate_command(CLI::App& app, Command& command) {
     sub->add_option("--count", options->count, "Number of primitives")->capture_default_str()->check(whole_number(1, 100000000));
     sub->add_option("--seed", options->seed, "Random seed")->capture_default_str()->check(seed_validator());
     sub->add_flag("--uniform", *uniform, "Scatter uniformly instead of in clusters");
-    sub->add_option("-o,--output", *output, "Output file (survey XML; .hbvh: binary), or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", *output, "Output file (survey XML; .hbvh: binary), or - for stdout")
+        ->capture_default_str()
+        ->check(hierarchy_output_name());
     sub->footer("Example: hbvh generate --count 1000 --seed 7 -o scene.xml");
     sub->callback([&command, options, output, uniform] {
         command = [options, output, uniform] {
