@@ -107,6 +107,9 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
          "</geometry></collision></link>\n</robot>",
          3, "<cylinder> attribute 'radius' must not be negative"},
         {"<robot name=\"r\">\n<link>\n</link>\n</robot>", 2, "<link> without a name"},
+        {"<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n<joint name=\"j\" type=\"fixed\">\n"
+         "<parent link=\"a\"/><child link=\"b\"/>\n<origin xyz=\"0 0\"/></joint>\n</robot>",
+         6, "<origin> attribute 'xyz' needs 3 finite numbers, found \"0 0\""},
     };
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const fs::path file = folder / ("case" + std::to_string(i) + ".urdf");
