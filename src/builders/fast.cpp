@@ -156,8 +156,6 @@ std::pair<std::size_t, std::size_t> refit_heaviest(Bvh& bvh, const BuildContext&
 }  // namespace
 
 Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext& context, const FastOptions& options) {
-    // Checked here, before the root's refit starts beside binned (whose own guard would come too late for it).
-    if (Status input = detail::check_build_input(primitives, context.policy); !input) return input.error();
     // binned reports its progress as the first half, the refits the second.
     BuildContext first_step = context;
     if (context.progress) first_step.progress = [&context](double fraction) { context.report_progress(0.5 * fraction); };
@@ -168,6 +166,9 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
     // time on 13-54 primitives, docs/fast.md). It is an inner node from 2 primitives on.
     EarlyRefits early(primitives, context.policy);
     if (refit && primitives.size() <= options.exact_fit_max_primitives) {
+        // binned's guard checks the input too, but only after this refit has started on it (a NaN weight made it
+        // recurse without end): checked here first. Larger inputs start no refit, and binned checks them once.
+        if (Status input = detail::check_build_input(primitives, context.policy); !input) return input.error();
         std::vector<std::uint32_t> all(primitives.size());
         for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
         early.start(std::move(all));
