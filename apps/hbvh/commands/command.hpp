@@ -105,10 +105,9 @@ struct BuilderFlags {
 [[nodiscard]] std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::string_view command);
 
 /// The model's stored hierarchy once it passes validate() (with flags.refit, its non-enclosing volumes
-/// refitted and a note printed), or one built from its primitives with `flags`. A stored hierarchy that
-/// fails is refused with "file:line: volume (obb) does not enclose primitive N ('name') by D".
-[[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags);
-/// As above, building a primitive set with `request` (resolve_or_report's) instead of resolving `flags` again.
+/// refitted and a note printed; a warning when `flags` would steer a build), or one built from its primitives with
+/// `request` (resolve_or_report's, so that the flags are resolved once). A stored hierarchy that fails is refused
+/// with "file:line: volume (obb) does not enclose primitive N ('name') by D".
 [[nodiscard]] Result<Bvh> hierarchy_of(const Model& model, const BuildRequest& request, const BuilderFlags& flags);
 /// Ok when the model has no stored hierarchy or its volumes enclose their primitives (or flags.refit, after
 /// a note); for build, which rebuilds from the primitives but must not pass over a broken file in silence.

@@ -212,13 +212,6 @@ std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::st
     return std::nullopt;
 }
 
-Result<Bvh> hierarchy_of(const Model& model, const BuilderFlags& flags) {
-    if (model.hierarchy) return hierarchy_of(model, BuildRequest{}, flags);
-    Result<BuildRequest> request = flags.resolve();
-    if (!request) return request.error();
-    return request->run(model.primitives);
-}
-
 Result<Bvh> hierarchy_of(const Model& model, const BuildRequest& request, const BuilderFlags& flags) {
     if (model.hierarchy) {
         if (flags.steer_a_build())

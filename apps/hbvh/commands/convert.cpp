@@ -34,7 +34,7 @@ void add_convert_command(CLI::App& app, Command& command) {
             // volumes miss their primitives into a binary one that looks trustworthy.
             std::optional<Bvh> hierarchy;
             if (model->hierarchy) {
-                Result<Bvh> checked = hierarchy_of(model.value(), args->checks);
+                Result<Bvh> checked = hierarchy_of(model.value(), BuildRequest{}, args->checks);
                 if (!checked) return report_error(checked.error());
                 hierarchy = std::move(checked.value());
             }
