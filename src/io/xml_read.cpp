@@ -241,8 +241,8 @@ private:
     Result<std::array<double, count>> read_numbers(const pugi::xml_node& element,
                                                    const pugi::xml_attribute& attribute) const;
     Result<Vec3> read_vector(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
-    Result<double> read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
-                             bool zero_allowed) const;
+    /// A size: 0 or a positive normal double (0: a point sphere, a flat box, a capsule of length 0).
+    Result<double> read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
     Result<Mat3> read_orientation(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const;
 
     std::string text_;      // parsed in place by doc_, so declared before it
@@ -567,7 +567,7 @@ Result<BoundingVolume> Reader::read_round(const pugi::xml_node& element, const V
     if (!radius_attribute) return radius_attribute.error();
     // Radius 0 (a point, a segment) is a valid primitive in the library, and build() keeps it: the file must
     // be able to hold what the writer writes.
-    const Result<double> radius = read_size(element, *radius_attribute, true);
+    const Result<double> radius = read_size(element, *radius_attribute);
     if (!radius) return radius.error();
     if (type == BvType::sphere) return BoundingVolume(Sphere{centre, *radius});
 
@@ -582,7 +582,7 @@ Result<BoundingVolume> Reader::read_round(const pugi::xml_node& element, const V
     const Result<pugi::xml_attribute> length_attribute = required(element, attributes, Key::length, type_name);
     if (!length_attribute) return length_attribute.error();
     // Length 0 is a sphere written as a capsule; that is still a valid capsule.
-    const Result<double> length = read_size(element, *length_attribute, true);
+    const Result<double> length = read_size(element, *length_attribute);
     if (!length) return length.error();
     const Vec3 half_axis = (0.5 * *length) * Vec3(*direction / norm);
     const Capsule capsule{centre - half_axis, centre + half_axis, *radius};
@@ -600,7 +600,7 @@ Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const Vol
         const Result<pugi::xml_attribute> attribute =
             required(element, attributes, axes[static_cast<std::size_t>(axis)], type_name);
         if (!attribute) return attribute.error();
-        const Result<double> extent = read_size(element, *attribute, true);  // 0: a flat box
+        const Result<double> extent = read_size(element, *attribute);  // 0: a flat box
         if (!extent) return extent.error();
         extents[axis] = *extent;
     }
@@ -669,8 +669,7 @@ Result<Vec3> Reader::read_vector(const pugi::xml_node& element, const pugi::xml_
     return Vec3((*numbers)[0], (*numbers)[1], (*numbers)[2]);
 }
 
-Result<double> Reader::read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute,
-                                 bool zero_allowed) const {
+Result<double> Reader::read_size(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const {
     const Result<std::array<double, 1>> numbers = read_numbers<1>(element, attribute);
     if (!numbers) return numbers.error();
     const double value = (*numbers)[0];
@@ -679,9 +678,9 @@ Result<double> Reader::read_size(const pugi::xml_node& element, const pugi::xml_
         return error(line_of(attribute, element), "attribute '" + std::string(attribute.name()) + "' is " +
                                                       attribute.value() +
                                                       ", below the smallest normal double (2.2e-308); sizes are 0 or normal");
-    if (value > 0.0 || (zero_allowed && value == 0.0)) return value;
-    return error(line_of(attribute, element), "attribute '" + std::string(attribute.name()) + "' must be " +
-                                                  (zero_allowed ? ">= 0" : "> 0") + ", found " + attribute.value());
+    if (value >= 0.0) return value;
+    return error(line_of(attribute, element),
+                 "attribute '" + std::string(attribute.name()) + "' must be >= 0, found " + attribute.value());
 }
 
 Result<Mat3> Reader::read_orientation(const pugi::xml_node& element, const pugi::xml_attribute& attribute) const {
