@@ -1,7 +1,6 @@
 // SPDX-License-Identifier: MIT
 // QueryTree: the read-only layout queries run on, converted once from a Bvh.
 #include <algorithm>
-#include <cstdio>
 #include <optional>
 #include <string>
 
@@ -10,6 +9,7 @@
 #include "../fit/frames.hpp"
 #include "../memory/huge_pages.hpp"
 #include "../tree/binary_decoding.hpp"
+#include "../tree/containment_error.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/tree/binary_format.hpp"
@@ -217,11 +217,7 @@ Status validate(const QueryTree& tree, double relative_tolerance) {
                     reach > worst || (worst_primitive && reach == worst && primitive < *worst_primitive))
                     worst = reach, worst_primitive = primitive;
         }
-        if (!worst_primitive) continue;
-        char by[32];
-        std::snprintf(by, sizeof by, "%.3g", worst);
-        return Error{"node " + std::to_string(i) + ": its " + std::string(to_string(type_of(volume))) +
-                     " does not contain primitive " + std::to_string(*worst_primitive) + " (by " + by + ")"};
+        if (worst_primitive) return detail::containment_error(i, type_of(volume), *worst_primitive, worst);
     }
     return Ok{};
 }

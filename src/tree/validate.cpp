@@ -10,6 +10,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include "../memory/huge_pages.hpp"
+#include "containment_error.hpp"
 #include "hbvh/geometry/validation.hpp"
 
 namespace hbvh {
@@ -143,10 +144,14 @@ Status validate(const Bvh& bvh, double relative_tolerance) {
     const std::vector<ContainmentViolation> violations = containment_violations(bvh, relative_tolerance);
     if (violations.empty()) return Ok{};
     const ContainmentViolation& first = violations.front();
+    return detail::containment_error(first.node, type_of(bvh.nodes[first.node].volume), first.primitive, first.protrusion);
+}
+
+Error detail::containment_error(std::uint32_t node, BvType kind, std::uint32_t primitive, double protrusion) {
     char by[32];
-    std::snprintf(by, sizeof by, "%.3g", first.protrusion);
-    return node_error(first.node, "its " + std::string(to_string(type_of(bvh.nodes[first.node].volume))) +
-                                      " does not contain primitive " + std::to_string(first.primitive) + " (by " + by + ")");
+    std::snprintf(by, sizeof by, "%.3g", protrusion);
+    return node_error(node, "its " + std::string(to_string(kind)) + " does not contain primitive " +
+                                std::to_string(primitive) + " (by " + by + ")");
 }
 
 }  // namespace hbvh
