@@ -2,6 +2,7 @@
 // hbvh: builds and queries heterogeneous bounding-volume hierarchies from the command line.
 #include <CLI/CLI.hpp>
 #include <cstdio>
+#include <exception>
 #include <new>
 
 #include "commands/command.hpp"
@@ -44,6 +45,12 @@ int main(int argc, char** argv) {
         // the machine has (a huge file, or a deep hierarchy exported with every level's primitives).
         std::fflush(stdout);
         std::fputs("hbvh: out of memory\n", stderr);
+        return exit_bad_input;
+    } catch (const std::exception& error) {
+        // The last resort: every failure the commands foresee is an Error with its file and line. An exception
+        // here is a defect of hbvh, but it must still end in a message and exit 1, not std::terminate's abort.
+        std::fflush(stdout);
+        std::fprintf(stderr, "hbvh: internal error (please report it): %s\n", error.what());
         return exit_bad_input;
     }
     // Whatever a command printed is checked once here: a full disk or a closed pipe behind standard output must

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "commands/command.hpp"
+#include "commands/json_text.hpp"
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 
@@ -18,6 +19,7 @@ namespace {
 struct CollideArguments {
     std::string input_a;
     std::string input_b;
+    std::string format;  ///< --format, for both inputs.
     std::optional<std::string> pose_a;  ///< Absent: the identity. Given, even empty, it must parse.
     std::optional<std::string> pose_b;
     BuilderFlags builder;
@@ -71,10 +73,12 @@ int run_collide(const CollideArguments& args) {
             fmt::print(stderr, "hbvh collide: {}\n", pose->error().to_string());
             return exit_bad_usage;
         }
-    Result<Model> model_a = load_model(args.input_a);
+    Result<Model> model_a = load_model(args.input_a, args.format);
     if (!model_a) return report_error(model_a.error());
-    Result<Model> model_b = load_model(args.input_b);
+    report_warnings(model_a->warnings);
+    Result<Model> model_b = load_model(args.input_b, args.format);
     if (!model_b) return report_error(model_b.error());
+    report_warnings(model_b->warnings);
     Result<Bvh> bvh_a = hierarchy_of(model_a.value(), *request, args.builder);
     if (!bvh_a) return report_error(bvh_a.error());
     Result<Bvh> bvh_b = hierarchy_of(model_b.value(), *request, args.builder);
@@ -90,7 +94,7 @@ int run_collide(const CollideArguments& args) {
                                  {"pairs", pairs},
                                  {"bv_tests", result.bv_tests},
                                  {"primitive_tests", result.primitive_tests}};
-        fmt::print("{}\n", out.dump());
+        fmt::print("{}\n", json_text(out));
     } else {
         fmt::print("{}\n", result.intersecting ? "intersecting" : "separate");
         for (const auto& [i, j] : result.pairs) fmt::print("  {} {}\n", i, j);
@@ -106,6 +110,7 @@ void add_collide_command(CLI::App& app, Command& command) {
     CLI::App* sub = app.add_subcommand("collide", "Test two posed objects for contact (tandem traversal)");
     sub->add_option("a", args->input_a, "First object: a hierarchy or a primitive set")->required();
     sub->add_option("b", args->input_b, "Second object")->required();
+    sub->add_option("--format", args->format, "Input format of both objects when their extensions do not tell");
     sub->add_option("--pose-a", args->pose_a, "Pose of a: \"tx ty tz [qw qx qy qz]\" (default identity)");
     sub->add_option("--pose-b", args->pose_b, "Pose of b (default identity)");
     args->builder.add_to(*sub);

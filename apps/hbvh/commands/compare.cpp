@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "commands/command.hpp"
+#include "commands/json_text.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh::cli {
@@ -167,7 +168,7 @@ void print_json(const std::vector<Row>& rows) {
         if (!row.error.empty()) entry["error"] = row.error;
         out.push_back(entry);
     }
-    fmt::print("{}\n", out.dump(2));
+    fmt::print("{}\n", json_text(out, 2));
 }
 
 int run_compare(const CompareArguments& args) {

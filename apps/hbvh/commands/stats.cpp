@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands/command.hpp"
+#include "commands/json_text.hpp"
 #include "hbvh/tree/stats.hpp"
 
 namespace hbvh::cli {
@@ -92,7 +93,7 @@ int run_stats(const StatsArguments& args) {
     if (args.json) {
         nlohmann::ordered_json out = to_json(stats);
         out["violations"] = violations_json(model.value(), bvh.value(), violations);
-        fmt::print("{}\n", out.dump(2));
+        fmt::print("{}\n", json_text(out, 2));
     } else {
         print_text(stats);
         if (violations.empty()) {
