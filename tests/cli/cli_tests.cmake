@@ -183,7 +183,7 @@ file(WRITE ${HBVH_CLI_OUT}/edited_weights.txt "${byte_order_mark}aabb=1\n\nobb=1
 hbvh_cli_test(type_weight_file_edited 0 "" build ${PROJECT_SOURCE_DIR}/data/models/chair.xml -a split
               --type-weight @${HBVH_CLI_OUT}/edited_weights.txt -o ${HBVH_CLI_OUT}/edited_weights_chair.xml)
 file(WRITE ${HBVH_CLI_OUT}/bad_weights.txt "aabb=1\nobb=heavy\n")
-hbvh_cli_test(type_weight_file_bad 2 "bad_weights.txt:2: type weight 'obb=heavy' needs a positive finite number"
+hbvh_cli_test(type_weight_file_bad 2 "bad_weights.txt:2: type weight 'obb=heavy': a weight must be a number from 1e-6 to 1e6"
               build ${PROJECT_SOURCE_DIR}/data/models/chair.xml --type-weight @${HBVH_CLI_OUT}/bad_weights.txt
               -o ${HBVH_CLI_OUT}/bad_weights_chair.xml)
 
@@ -246,3 +246,22 @@ hbvh_cli_test(optimal_above_its_limit 0 "warning: optimal: 27 primitives exceed 
 # three units keep insertion-haber's tree with one treelet replaced; the default seven end at scale's, 40.278.
 hbvh_cli_test(treelet_units.auto 0 "1 of 27 treelets replaced, [0-9]+ fits, cost 41.8691 -> 41.8559" build
               ${PROJECT_SOURCE_DIR}/data/models/cannon.xml --treelet-units 3 --report -o ${HBVH_CLI_OUT}/cannon_units3.xml)
+
+# A user's review (2026-12-07, second round). JSON output naming a file whose name is no UTF-8 (a Latin-1 byte) is written
+# with U+FFFD, not aborted in nlohmann's dump; weights far outside [1e-6, 1e6] and a kind weighted twice are usage
+# errors (1e308 hung stats, whose costs overflowed); simulate exits 1 when no moving query was measured (point
+# spheres never meet in flight) instead of printing means of 0 ms; export to SVG without a TMPDIR says so.
+string(ASCII 233 latin1_e_acute)
+file(WRITE ${HBVH_CLI_OUT}/caf${latin1_e_acute}.xml "<hierarchy>\n  <volume type=\"sphere\" name=\"caf${latin1_e_acute}\" pos=\"0 0 0\" radius=\"1\" />\n  <volume type=\"sphere\" pos=\"3 0 0\" radius=\"1\" />\n</hierarchy>\n")
+hbvh_cli_test(compare_json_latin1_name 0 "" compare ${HBVH_CLI_OUT}/caf${latin1_e_acute}.xml -a two-level --json)
+hbvh_cli_test(simulate_json_latin1_name 0 "" simulate ${HBVH_CLI_OUT}/caf${latin1_e_acute}.xml --collisions 5 --json)
+hbvh_cli_test(type_weight_huge 2 "from 1e-6 to 1e6" stats ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              --type-weight aabb=1e308,obb=1e308,sphere=1e308,capsule=1e308)
+hbvh_cli_test(type_weight_twice 2 "obb is weighted twice" stats ${PROJECT_SOURCE_DIR}/data/models/chair.xml
+              --type-weight obb=1,obb=2)
+file(WRITE ${HBVH_CLI_OUT}/point_spheres.xml "<hierarchy>\n  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"0\" />\n  <volume type=\"sphere\" pos=\"0 0 0\" radius=\"0\" />\n</hierarchy>\n")
+hbvh_cli_test(simulate_nothing_measured 1 "no moving query was measured" simulate ${HBVH_CLI_OUT}/point_spheres.xml
+              --collisions 10 --json)
+add_test(NAME cli.export_without_tmpdir
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}
+                 -P ${CMAKE_CURRENT_LIST_DIR}/export_without_tmpdir.cmake)

@@ -4,7 +4,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 
@@ -66,8 +68,13 @@ std::filesystem::path find_on_path(const std::string& program) {
 Result<std::string> render_svg(const std::string& dot_text) {
     const std::filesystem::path dot = find_on_path("dot");
     if (dot.empty()) return Error{"Graphviz 'dot' was not found on PATH; install graphviz, or write .dot instead"};
-    std::string pattern = (std::filesystem::temp_directory_path() / "hbvh-export-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr) return Error{"cannot create a temporary directory"};
+    // The error_code form: the throwing one ended the process when TMPDIR names no directory.
+    std::error_code no_temp;
+    const std::filesystem::path temp = std::filesystem::temp_directory_path(no_temp);
+    if (no_temp) return Error{"no directory for temporary files (TMPDIR names none): " + no_temp.message()};
+    std::string pattern = (temp / "hbvh-export-XXXXXX").string();
+    if (::mkdtemp(pattern.data()) == nullptr)
+        return Error{"cannot create a temporary directory in " + temp.string() + ": " + std::strerror(errno)};
     const std::filesystem::path dir = pattern;
     // Removes the directory however this function ends.
     const auto cleanup = std::unique_ptr<const std::filesystem::path, void (*)(const std::filesystem::path*)>(
@@ -110,7 +117,9 @@ int run_export(const ExportArguments& args) {
     if (*format == "gltf") {
         GltfOptions options;
         options.side_by_side = !args.overlay;
-        content = export_gltf(bvh.value(), options);
+        Result<std::string> gltf = export_gltf(bvh.value(), options);
+        if (!gltf) return report_error(Error{gltf.error().message, args.input});
+        content = std::move(gltf.value());
     } else {
         content = export_dot(bvh.value(), {.carry_leaves = !args.no_carry});
         if (*format == "svg") {
