@@ -128,6 +128,8 @@ TEST(Registry, EveryBuilderRefusesAPolicyItCannotWorkWith) {
     nan_weight.policy.weight[static_cast<std::size_t>(BvType::obb)] = std::numeric_limits<double>::quiet_NaN();
     BuildContext negative_weight;
     negative_weight.policy.weight[static_cast<std::size_t>(BvType::sphere)] = -1.0;
+    BuildContext huge_weights;  // 1e308 on every kind: costs overflowed to inf, and optimal and auto never pruned
+    huge_weights.policy.weight.fill(1e308);
     BuildContext nothing_allowed;
     nothing_allowed.policy.allowed = {false, false, false, false};
     BuildContext disallowed_nan;  // a kind that is not allowed may weigh anything
@@ -138,6 +140,9 @@ TEST(Registry, EveryBuilderRefusesAPolicyItCannotWorkWith) {
         ASSERT_FALSE(nan.has_value()) << row.name;
         EXPECT_NE(nan.error().message.find("the weight of obb is nan"), std::string::npos) << nan.error().message;
         ASSERT_FALSE(row.build(primitives, negative_weight).has_value()) << row.name;
+        const Result<Bvh> huge = row.build(primitives, huge_weights);
+        ASSERT_FALSE(huge.has_value()) << row.name;
+        EXPECT_NE(huge.error().message.find("from 1e-6 to 1e6"), std::string::npos) << huge.error().message;
         const Result<Bvh> none = row.build(primitives, nothing_allowed);
         ASSERT_FALSE(none.has_value()) << row.name;
         EXPECT_NE(none.error().message.find("no BV kind is allowed"), std::string::npos) << none.error().message;

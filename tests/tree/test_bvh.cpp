@@ -197,6 +197,15 @@ TEST(VolumePolicy, ParsesTypesAndWeights) {
     EXPECT_FALSE(parse_type_weights("obb=0").has_value());
     EXPECT_FALSE(parse_type_weights("obb=nan").has_value());
     EXPECT_FALSE(parse_type_weights("obb").has_value());
+    // Weights are ratios of test costs: far outside [1e-6, 1e6] they only overflow or underflow the cost.
+    EXPECT_TRUE(parse_type_weights("obb=1e-6,capsule=1e6").has_value());
+    EXPECT_FALSE(parse_type_weights("obb=1e308").has_value());
+    EXPECT_FALSE(parse_type_weights("obb=1e-320").has_value());
+    EXPECT_FALSE(parse_type_weights("obb=9.9e-7").has_value());
+    // A kind weighted twice is refused: which weight was meant cannot be told.
+    const Result<VolumePolicy> twice = parse_type_weights("obb=1,sphere=2,obb=2");
+    ASSERT_FALSE(twice.has_value());
+    EXPECT_NE(twice.error().message.find("obb is weighted twice"), std::string::npos) << twice.error().message;
 }
 
 // The file `hbvh calibrate -o` writes: its table of pairs as '#' comments, then the weights; entries may also come
@@ -224,6 +233,10 @@ TEST(VolumePolicy, ReadsTheCalibratedWeightsFileAndNamesTheLineOfABadEntry) {
     EXPECT_EQ(bad.error().line, 3);
     EXPECT_EQ(bad.error().file, path.string());
     EXPECT_NE(bad.error().message.find("obb=heavy"), std::string::npos);
+    const Result<VolumePolicy> repeated = read("aabb=1\nobb=2\naabb=3\n");  // also across lines
+    ASSERT_FALSE(repeated.has_value());
+    EXPECT_EQ(repeated.error().line, 3);
+    EXPECT_NE(repeated.error().message.find("aabb is weighted twice"), std::string::npos);
     const Result<VolumePolicy> comments_only = read("# nothing measured\n");
     EXPECT_FALSE(comments_only.has_value());
     std::filesystem::remove(path);

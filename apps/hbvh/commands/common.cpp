@@ -115,7 +115,7 @@ void BuilderFlags::add_to(CLI::App& command, bool choose_builder) {
     }
     command.add_option("--types", types, "Allowed BV types for inner nodes, comma-separated")->capture_default_str();
     command.add_option("--type-weight", type_weights,
-                       "Per-type cost weights, e.g. obb=1.5,capsule=1.2 (default 1 each), or @FILE as `hbvh calibrate` writes");
+                       "Per-type cost weights from 1e-6 to 1e6, each type at most once, e.g. obb=1.5,capsule=1.2 (default 1 each), or @FILE as `hbvh calibrate` writes");
     command.add_option("--objective", objective,
                        "Cost the builder minimises: eq2 (Eq. 2, node volume) or calibrated (node "
                        "measured by its Minkowski sum with a turned copy; docs/metrics.md)")

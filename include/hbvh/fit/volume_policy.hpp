@@ -43,13 +43,20 @@ struct VolumePolicy {
     [[nodiscard]] static VolumePolicy only(BvType type);
 };
 
+/// The range of a kind's weight. Weights are ratios of test costs (`hbvh calibrate` measures 0.4-1.3); outside
+/// [1e-6, 1e6] they only push a tree's cost towards overflow (weights of 1e308 made costs infinite, and
+/// `optimal` and `auto` then never pruned) or underflow (1e-320: subnormal costs that compare as ties).
+inline constexpr double min_type_weight = 1e-6;
+inline constexpr double max_type_weight = 1e6;
+
 /// Ok, or the Error that refuses a policy no builder can work with: no kind allowed, or an allowed kind whose
-/// weight is not a positive finite number (a NaN weight made comparisons fail and builders recurse without end).
-/// Every builder checks it before it starts, as it checks the primitives.
+/// weight is not a number from min_type_weight to max_type_weight (a NaN weight made comparisons fail and
+/// builders recurse without end). Every builder checks it before it starts, as it checks the primitives.
 [[nodiscard]] Status validate_policy(const VolumePolicy& policy);
 /// Parses "aabb,obb,sphere,capsule" (any non-empty subset, any order). Error names the bad word.
 [[nodiscard]] Result<VolumePolicy> parse_allowed_types(std::string_view list, VolumePolicy base = {});
-/// Parses "obb=1.5,capsule=1.2" into weights (positive, finite). Error names the bad entry.
+/// Parses "obb=1.5,capsule=1.2" into weights (from min_type_weight to max_type_weight, each kind at most once).
+/// Error names the bad entry.
 [[nodiscard]] Result<VolumePolicy> parse_type_weights(std::string_view list, VolumePolicy base = {});
 /// Reads the weights `hbvh calibrate -o FILE` writes: parse_type_weights' entries, separated by commas, blanks
 /// or lines, after '#' comments (its table of pairs) are dropped, a byte order mark allowed. Errors name the file.
