@@ -146,7 +146,7 @@ Result<ImportResult> import_mesh(const std::string& path, const MeshImportOption
     });
     if (!has_collision_meshes && !options.one_primitive_per_mesh)
         return Error("no collision meshes (names starting UBX_, USP_, UCP_ or UCX_); set one_primitive_per_mesh "
-                     "(hbvh's --format mesh-nodes) to fit one primitive per render mesh",
+                     "(the CLI's --format mesh-nodes, --input-format in hbvh export) to fit one primitive per render mesh",
                      path);
     std::size_t ignored = 0;
     for (const MeshInstance& instance : instances) {

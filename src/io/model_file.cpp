@@ -149,8 +149,8 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         if (survey) return from_xml(detail::read_xml_taking(std::move(text).value(), path));
         if (by_bytes)
             return Error{"unknown file type '" + extension +
-                             "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format "
-                             "(hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
+                             "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format (--input-format "
+                             "in hbvh export: hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
                              ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
                          path};
     }

@@ -12,12 +12,14 @@
 // kind alike instead (the row's mean) ranked the trees of generated objects worse and made their calibrated
 // trees slower (docs/metrics.md, "Per-kind weights"), so the table of pairs is written for the record only.
 #include <fmt/core.h>
-
-#include <cstdio>
-#include <filesystem>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <span>
 #include <string_view>
 #include <utility>
@@ -89,6 +91,11 @@ int run_calibrate(const CalibrateArguments& args) {
         std::error_code ignored;
         if (!std::filesystem::is_directory(folder, ignored))
             return report_error(Error{"cannot write: the folder " + folder.string() + " does not exist", args.output});
+        // The output is written next to itself and renamed, so the folder must take a new file.
+        if (::access(folder.c_str(), W_OK | X_OK) != 0)
+            return report_error(Error{"cannot write: the folder " + folder.string() + " does not take new files (" +
+                                          std::strerror(errno) + ")",
+                                      args.output});
         if (std::filesystem::is_directory(output, ignored))
             return report_error(Error{"is a directory, not a file: give the output a file name", args.output});
     }
