@@ -5,10 +5,12 @@
 
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <string_view>
 
 #include "hbvh/io/level_view.hpp"
@@ -87,7 +89,7 @@ struct MeshAccessors {
 
 }  // namespace
 
-std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
+Result<std::string> export_gltf(const Bvh& bvh, const GltfOptions& options) {
     json gltf;
     gltf["asset"] = {{"version", "2.0"}, {"generator", std::string("hbvh ") + HBVH_VERSION_STRING}};
     gltf["scene"] = 0;
@@ -97,16 +99,23 @@ std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
         return gltf.dump(1, ' ', false, json::error_handler_t::replace);
     }
 
-    // Stage 1: tessellate every node; positions and normals interleaved in one buffer view, indices in
-    // a second. Accessor min/max are taken from the float values actually stored, as validators demand.
+    // Stage 1: tessellate every node about its origin (the centre of its world AABB, which its glTF node's
+    // translation restores); positions and normals interleaved in one buffer view, indices in a second.
+    // Accessor min/max are taken from the float values actually stored, as validators demand.
     std::vector<TriangleMesh> meshes;
+    std::vector<Vec3> origins;
     meshes.reserve(bvh.nodes.size());
-    for (const Node& node : bvh.nodes) meshes.push_back(triangulate(node.volume, options.detail));
+    origins.reserve(bvh.nodes.size());
+    for (const Node& node : bvh.nodes) {
+        meshes.push_back(triangulate(node.volume, options.detail));
+        origins.push_back(world_aabb(node.volume).center());
+    }
     ByteWriter vertices, indices;
     json accessors = json::array();
     std::vector<MeshAccessors> node_accessors;
     node_accessors.reserve(meshes.size());
-    for (const TriangleMesh& mesh : meshes) {
+    for (std::size_t n = 0; n < meshes.size(); ++n) {
+        const TriangleMesh& mesh = meshes[n];
         const std::size_t vertex_offset = vertices.size();
         const std::size_t index_offset = indices.size();
         std::array<float, 3> lo{}, hi{};
@@ -114,7 +123,9 @@ std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
         hi.fill(-std::numeric_limits<float>::infinity());
         for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
             for (Eigen::Index k = 0; k < 3; ++k) {
-                const auto value = static_cast<float>(mesh.positions[i][k]);
+                const auto value = static_cast<float>(mesh.positions[i][k] - origins[n][k]);
+                if (!std::isfinite(value))
+                    return Error{"node " + std::to_string(n) + " is wider than a glTF float holds (3.4e38)"};
                 lo[k] = std::min(lo[k], value);
                 hi[k] = std::max(hi[k], value);
                 vertices.put_float(value);
@@ -177,9 +188,14 @@ std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
         const std::size_t level_material = materials.size();
         materials.push_back(material("level " + std::to_string(view.depth), level_color(view.depth), options.opacity));
         json children = json::array();
+        const auto at_origin = [&](std::uint32_t index) {
+            const Vec3& o = origins[index];
+            return json::array({o.x(), o.y(), o.z()});
+        };
         for (std::uint32_t index : view.nodes) {
             nodes.push_back({{"name", node_name(bvh, index)},
                              {"mesh", add_mesh(index, level_material, "")},
+                             {"translation", at_origin(index)},
                              {"extras", {{"hbvh_node", index}, {"volume", volume(bvh.nodes[index].volume)},
                                          {"carried", false}}}});
             children.push_back(nodes.size() - 1);
@@ -192,6 +208,7 @@ std::string export_gltf(const Bvh& bvh, const GltfOptions& options) {
             if (!carried_mesh[index]) carried_mesh[index] = add_mesh(index, *carried_material, " carried");
             nodes.push_back({{"name", node_name(bvh, index) + " carried"},
                              {"mesh", *carried_mesh[index]},
+                             {"translation", at_origin(index)},
                              {"extras", {{"hbvh_node", index}, {"volume", volume(bvh.nodes[index].volume)},
                                          {"carried", true}}}});
             children.push_back(nodes.size() - 1);

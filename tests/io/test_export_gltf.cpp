@@ -9,6 +9,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "hbvh/builders/build.hpp"
 #include "hbvh/io/export_gltf.hpp"
 #include "hbvh/io/level_view.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -49,7 +50,7 @@ float read_float(const std::vector<std::uint8_t>& bytes, std::size_t offset) {
 
 TEST(ExportGltf, OneSceneNodePerLevelWithEveryShownBv) {
     const Bvh bvh = test::sample_hierarchy();
-    const json gltf = json::parse(export_gltf(bvh));
+    const json gltf = json::parse(export_gltf(bvh).value());
     EXPECT_EQ(gltf["asset"]["version"], "2.0");
     const std::vector<LevelView> views = level_views(bvh);
     const json& roots = gltf["scenes"][0]["nodes"];
@@ -75,15 +76,15 @@ TEST(ExportGltf, OneSceneNodePerLevelWithEveryShownBv) {
 
 TEST(ExportGltf, EmbeddedBufferHoldsTheMeshes) {
     const Bvh bvh = test::sample_hierarchy();
-    const json gltf = json::parse(export_gltf(bvh));
+    const json gltf = json::parse(export_gltf(bvh).value());
     const std::string uri = gltf["buffers"][0]["uri"];
     const std::string prefix = "data:application/octet-stream;base64,";
     ASSERT_EQ(uri.rfind(prefix, 0), 0u);
     const std::vector<std::uint8_t> bytes = decode_base64(uri.substr(prefix.size()));
     ASSERT_EQ(bytes.size(), gltf["buffers"][0]["byteLength"].get<std::size_t>());
 
-    // Every BV-bearing node: its POSITION accessor's bounds are the BV's world AABB (as floats), and
-    // the stored positions agree with those bounds.
+    // Every BV-bearing node: placed at the centre of the BV's world AABB, its POSITION accessor's bounds are that
+    // AABB about the centre (as floats), and the stored positions agree with those bounds.
     for (const json& node : gltf["nodes"]) {
         if (!node.contains("mesh")) continue;
         const std::uint32_t index = node["extras"]["hbvh_node"];
@@ -91,8 +92,10 @@ TEST(ExportGltf, EmbeddedBufferHoldsTheMeshes) {
         const json& accessor = gltf["accessors"][primitive["attributes"]["POSITION"].get<std::size_t>()];
         const Aabb expected = world_aabb(bvh.nodes[index].volume);
         for (int k = 0; k < 3; ++k) {
-            EXPECT_FLOAT_EQ(accessor["min"][k].get<float>(), static_cast<float>(expected.min[k]));
-            EXPECT_FLOAT_EQ(accessor["max"][k].get<float>(), static_cast<float>(expected.max[k]));
+            const double origin = node["translation"][k].get<double>();
+            EXPECT_EQ(origin, expected.center()[k]);
+            EXPECT_FLOAT_EQ(accessor["min"][k].get<float>(), static_cast<float>(expected.min[k] - origin));
+            EXPECT_FLOAT_EQ(accessor["max"][k].get<float>(), static_cast<float>(expected.max[k] - origin));
         }
         const json& view = gltf["bufferViews"][accessor["bufferView"].get<std::size_t>()];
         const std::size_t stride = view["byteStride"];
@@ -107,7 +110,7 @@ TEST(ExportGltf, EmbeddedBufferHoldsTheMeshes) {
 }
 
 TEST(ExportGltf, EmptyHierarchyIsAValidEmptyAsset) {
-    const json gltf = json::parse(export_gltf(Bvh{}));
+    const json gltf = json::parse(export_gltf(Bvh{}).value());
     EXPECT_EQ(gltf["scenes"].size(), 1u);
     EXPECT_FALSE(gltf["scenes"][0].contains("nodes"));
 }
@@ -134,7 +137,7 @@ void expect_valid_gltf(const std::string& text, const std::string& name) {
 }
 
 TEST(ExportGltf, KhronosValidatorFindsNoErrors) {
-    expect_valid_gltf(export_gltf(test::sample_hierarchy()), "sample");
+    expect_valid_gltf(export_gltf(test::sample_hierarchy()).value(), "sample");
 }
 
 TEST(ExportGltf, KhronosValidatorAcceptsAFlatTwoLevelScene) {
@@ -153,7 +156,45 @@ TEST(ExportGltf, KhronosValidatorAcceptsAFlatTwoLevelScene) {
     const Bvh bvh = std::move(assembler).finish(assembler.add_group(leaves, box));
     GltfOptions gltf_options;
     gltf_options.side_by_side = false;
-    expect_valid_gltf(export_gltf(bvh, gltf_options), "flat");
+    expect_valid_gltf(export_gltf(bvh, gltf_options).value(), "flat");
+}
+
+// Far from the origin, world coordinates as floats had kept 8 mm at 10^5 (a 4 cm box came out 3.9 cm wide):
+// each mesh is now stored about its own centre, so a box keeps its size to float precision of the size.
+TEST(ExportGltf, FarFromTheOriginEveryMeshKeepsItsSize) {
+    std::vector<Primitive> primitives;
+    for (int i = 0; i < 3; ++i)
+        primitives.push_back({Aabb{Vec3(1e5 + 0.1 * i, 2e5, -3e5), Vec3(1e5 + 0.1 * i + 0.04, 2e5 + 0.035, -3e5 + 0.03)}, ""});
+    TreeAssembler assembler(primitives);
+    std::vector<std::uint32_t> leaves;
+    Aabb box = Aabb::empty();
+    for (std::uint32_t i = 0; i < primitives.size(); ++i) {
+        leaves.push_back(assembler.add_leaf(i));
+        box = box.merged(world_aabb(primitives[i].volume));
+    }
+    const Bvh bvh = std::move(assembler).finish(assembler.add_group(leaves, box));
+    const json gltf = json::parse(export_gltf(bvh).value());
+    for (const json& node : gltf["nodes"]) {
+        if (!node.contains("mesh")) continue;
+        const Aabb expected = world_aabb(bvh.nodes[node["extras"]["hbvh_node"].get<std::uint32_t>()].volume);
+        const json& primitive = gltf["meshes"][node["mesh"].get<std::size_t>()]["primitives"][0];
+        const json& accessor = gltf["accessors"][primitive["attributes"]["POSITION"].get<std::size_t>()];
+        for (int k = 0; k < 3; ++k) {
+            const double width = accessor["max"][k].get<double>() - accessor["min"][k].get<double>();
+            const double true_width = expected.max[k] - expected.min[k];
+            EXPECT_NEAR(width, true_width, 1e-6 * true_width) << "axis " << k;
+        }
+    }
+    expect_valid_gltf(gltf.dump(), "far");
+}
+
+// A BV wider than a float holds has no mesh a viewer could draw: an Error, not a file with null bounds.
+TEST(ExportGltf, RefusesABvWiderThanAFloatHolds) {
+    const std::vector<Primitive> primitives{{Sphere{Vec3::Zero(), 1e39}, ""}};
+    const Bvh bvh = build(primitives, Algorithm::two_level).value();
+    const Result<std::string> gltf = export_gltf(bvh);
+    ASSERT_FALSE(gltf.has_value());
+    EXPECT_NE(gltf.error().message.find("wider than a glTF float holds"), std::string::npos) << gltf.error().message;
 }
 
 }  // namespace

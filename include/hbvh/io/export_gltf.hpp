@@ -5,6 +5,7 @@
 #include <string>
 
 #include "hbvh/io/bv_mesh.hpp"
+#include "hbvh/result.hpp"
 #include "hbvh/tree/bvh.hpp"
 
 namespace hbvh {
@@ -24,8 +25,11 @@ struct GltfOptions {
 /// for leaves, and carry {"hbvh_node", "volume", "carried"} in their extras; level nodes carry
 /// {"depth", "nodes", "carried", "volume", "cost"}. Every BV is a triangle mesh with normals
 /// (triangulate()); each level has its own translucent material (alphaMode BLEND, double-sided,
-/// colour level_color(depth)) and carried leaves share a grey one. Coordinates are the hierarchy's
-/// world coordinates as 32-bit floats. An empty hierarchy gives a valid asset with an empty scene.
-[[nodiscard]] std::string export_gltf(const Bvh& bvh, const GltfOptions& options = {});
+/// colour level_color(depth)) and carried leaves share a grey one. Each BV's node is placed at the centre of
+/// the BV's world AABB by its "translation" (JSON doubles, so the placement is exact) and its mesh is stored
+/// about that centre as 32-bit floats: a model 10^5 units from the origin keeps its millimetres, where world
+/// coordinates as floats had kept 8 mm. An empty hierarchy gives a valid asset with an empty scene. Error for a
+/// BV wider than a float can hold (3.4e38), whose mesh no viewer could draw.
+[[nodiscard]] Result<std::string> export_gltf(const Bvh& bvh, const GltfOptions& options = {});
 
 }  // namespace hbvh
