@@ -265,3 +265,8 @@ hbvh_cli_test(simulate_nothing_measured 1 "no moving query was measured" simulat
 add_test(NAME cli.export_without_tmpdir
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR} -DOUT=${HBVH_CLI_OUT}
                  -P ${CMAKE_CURRENT_LIST_DIR}/export_without_tmpdir.cmake)
+# simulate and collide read --format, as the other commands that read a model do (it was "not expected").
+configure_file(${PROJECT_SOURCE_DIR}/data/models/chair.xml ${HBVH_CLI_OUT}/chair_named.txt COPYONLY)
+hbvh_cli_test(simulate_format 0 "" simulate ${HBVH_CLI_OUT}/chair_named.txt --format xml -a fast --collisions 5)
+hbvh_cli_test(collide_format 0 "" collide ${HBVH_CLI_OUT}/chair_named.txt ${HBVH_CLI_OUT}/chair_named.txt --format xml
+              -a fast --pose-b "0.3 0 0")
