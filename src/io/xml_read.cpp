@@ -27,6 +27,7 @@
 #include <pugixml.hpp>
 
 #include "hbvh/assert.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/file.hpp"
 #include "../memory/huge_pages.hpp"
 #include "xml_number.hpp"
@@ -705,6 +706,10 @@ Result<Mat3> Reader::read_orientation(const pugi::xml_node& element, const pugi:
         append_number(shown, std::round(determinant * 1000.0) / 1000.0);
         return error(line_of(attribute, element), "attribute 'orientation' is a reflection (determinant " + shown + "), not a rotation");
     }
+    // A matrix that is a rotation to the library's own tolerance (what hbvh writes, with every digit) is kept
+    // bit for bit, so that reading a file hbvh wrote gives back its volumes and a rewrite is the same file
+    // (replacing every matrix by its polar factor changed the last bits of each OBB on every pass).
+    if (rotation_problem(m).empty()) return m;
     // Polar decomposition M = (U V^T)(V S V^T): U V^T is the rotation nearest to M in the Frobenius norm.
     // det(M) > 0 and S near 1 make det(U V^T) = +1, so this is a proper rotation.
     const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
