@@ -615,6 +615,9 @@ private:
                                         std::uint8_t* split) const {
         CollapseCosts best;
         best.fill(infinity);
+        // Two pieces, one from each side, are always a valid choice: recorded first, so that where every price is
+        // infinite (volumes that overflow) the pieces below still add up instead of recursing on a share of 0.
+        if (split != nullptr) split[2] = 1;
         const std::uint32_t m = max_children_;
         for (std::uint32_t k = 2; k <= m; ++k)
             for (std::uint32_t i = 1; i < k; ++i) {
