@@ -140,12 +140,8 @@ TEST(ExportGltf, KhronosValidatorFindsNoErrors) {
     expect_valid_gltf(export_gltf(test::sample_hierarchy()).value(), "sample");
 }
 
-TEST(ExportGltf, KhronosValidatorAcceptsAFlatTwoLevelScene) {
-    // A root over a generated scene, without fitters: the root is the union AABB of the leaves.
-    SceneOptions options;
-    options.count = 40;
-    options.seed = 3;
-    const std::vector<Primitive> primitives = generate_scene(options);
+/// A root over every primitive, without fitters: the root is the union AABB of the leaves.
+Bvh flat_tree(const std::vector<Primitive>& primitives) {
     TreeAssembler assembler(primitives);
     std::vector<std::uint32_t> leaves;
     Aabb box = Aabb::empty();
@@ -153,7 +149,16 @@ TEST(ExportGltf, KhronosValidatorAcceptsAFlatTwoLevelScene) {
         leaves.push_back(assembler.add_leaf(i));
         box = box.merged(world_aabb(primitives[i].volume));
     }
-    const Bvh bvh = std::move(assembler).finish(assembler.add_group(leaves, box));
+    return std::move(assembler).finish(assembler.add_group(leaves, box));
+}
+
+TEST(ExportGltf, KhronosValidatorAcceptsAFlatTwoLevelScene) {
+    // A root over a generated scene.
+    SceneOptions options;
+    options.count = 40;
+    options.seed = 3;
+    const std::vector<Primitive> primitives = generate_scene(options);
+    const Bvh bvh = flat_tree(primitives);
     GltfOptions gltf_options;
     gltf_options.side_by_side = false;
     expect_valid_gltf(export_gltf(bvh, gltf_options).value(), "flat");
@@ -165,14 +170,7 @@ TEST(ExportGltf, FarFromTheOriginEveryMeshKeepsItsSize) {
     std::vector<Primitive> primitives;
     for (int i = 0; i < 3; ++i)
         primitives.push_back({Aabb{Vec3(1e5 + 0.1 * i, 2e5, -3e5), Vec3(1e5 + 0.1 * i + 0.04, 2e5 + 0.035, -3e5 + 0.03)}, ""});
-    TreeAssembler assembler(primitives);
-    std::vector<std::uint32_t> leaves;
-    Aabb box = Aabb::empty();
-    for (std::uint32_t i = 0; i < primitives.size(); ++i) {
-        leaves.push_back(assembler.add_leaf(i));
-        box = box.merged(world_aabb(primitives[i].volume));
-    }
-    const Bvh bvh = std::move(assembler).finish(assembler.add_group(leaves, box));
+    const Bvh bvh = flat_tree(primitives);
     const json gltf = json::parse(export_gltf(bvh).value());
     for (const json& node : gltf["nodes"]) {
         if (!node.contains("mesh")) continue;
