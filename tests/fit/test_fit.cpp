@@ -19,6 +19,7 @@
 #include "hbvh/fit/fit.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "support/test_helpers.hpp"
+#include "support/tree_properties.hpp"
 
 namespace hbvh {
 namespace {
@@ -204,21 +205,6 @@ BoundingVolume best_of_separate_fitters(const SphereSet& set, const VolumePolicy
     return *best;
 }
 
-bool same_bits(const BoundingVolume& a, const BoundingVolume& b) {
-    if (a.index() != b.index()) return false;
-    return std::visit(
-        [&](const auto& x) {
-            using T = std::decay_t<decltype(x)>;
-            const T& y = std::get<T>(b);
-            if constexpr (std::is_same_v<T, Aabb>) return x.min == y.min && x.max == y.max;
-            if constexpr (std::is_same_v<T, Obb>)
-                return x.center == y.center && x.rotation == y.rotation && x.half_extents == y.half_extents;
-            if constexpr (std::is_same_v<T, Sphere>) return x.center == y.center && x.radius == y.radius;
-            if constexpr (std::is_same_v<T, Capsule>) return x.p0 == y.p0 && x.p1 == y.p1 && x.radius == y.radius;
-        },
-        a);
-}
-
 /// Every kind at weight 1, and weights that make capsules cheap (their step rarely skipped) and dear (nearly always
 /// skipped).
 std::vector<VolumePolicy> capsule_weightings() {
@@ -246,7 +232,7 @@ TEST(Fit, FitBestEqualsTheBestOfTheSeparateFitters) {
     for (const SphereSet& set : all_sets())
         for (const VolumePolicy& policy : policies) {
             const BoundingVolume best = fit_best(set.spheres, policy, set.hints);
-            EXPECT_TRUE(same_bits(best, best_of_separate_fitters(set, policy))) << set.name;
+            EXPECT_TRUE(test_support::same_volume(best, best_of_separate_fitters(set, policy))) << set.name;
             capsule_wins += type_of(best) == BvType::capsule ? 1 : 0;
         }
     EXPECT_GT(capsule_wins, 0);  // the comparison covered capsules that were fitted, not only skipped ones
