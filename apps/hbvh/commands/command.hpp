@@ -104,6 +104,10 @@ struct BuilderFlags {
 /// command (it was exit 1 in those that build only when given a primitive set).
 [[nodiscard]] std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::string_view command);
 
+/// Warns on stderr when `model` stores a hierarchy, which is used as it is (or `measured`, by stats, which weighs
+/// its cost by --type-weight), and `flags` would steer a build (they apply to primitive sets only).
+void warn_if_build_flags_unused(const Model& model, const BuilderFlags& flags, bool measured);
+
 /// The model's stored hierarchy once it passes validate() (with flags.refit, its non-enclosing volumes
 /// refitted and a note printed; a warning when `flags` would steer a build), or one built from its primitives with
 /// `request` (resolve_or_report's, so that the flags are resolved once). A stored hierarchy that fails is refused

@@ -212,13 +212,21 @@ std::optional<BuildRequest> resolve_or_report(const BuilderFlags& flags, std::st
     return std::nullopt;
 }
 
+void warn_if_build_flags_unused(const Model& model, const BuilderFlags& flags, bool measured) {
+    // stats measures a stored tree and weighs its cost by --type-weight, so that flag is not among the unused.
+    BuilderFlags steering = flags;
+    if (measured) steering.type_weights.clear();
+    if (!model.hierarchy || !steering.steer_a_build()) return;
+    fmt::print(stderr,
+               "hbvh: warning: {} stores a hierarchy, which is {} as it is: the flags that choose and steer a build "
+               "(-a, --quality, --types, {}--objective, --refine, --treelet-units, --time-limit) apply to primitive "
+               "sets\n",
+               model.source, measured ? "measured" : "used", measured ? "" : "--type-weight, ");
+}
+
 Result<Bvh> hierarchy_of(const Model& model, const BuildRequest& request, const BuilderFlags& flags) {
     if (model.hierarchy) {
-        if (flags.steer_a_build())
-            fmt::print(stderr, "hbvh: warning: {} stores a hierarchy, which is used as it is: the flags that choose and "
-                               "steer a build (-a, --quality, --types, --type-weight, --objective, --refine, "
-                               "--treelet-units, --time-limit) apply to primitive sets\n",
-                       model.source);
+        warn_if_build_flags_unused(model, flags, /*measured=*/false);
         return checked_stored_hierarchy(model, flags);
     }
     return request.run(model.primitives);

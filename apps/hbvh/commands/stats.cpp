@@ -76,12 +76,7 @@ int run_stats(const StatsArguments& args) {
     report_warnings(model->warnings);
     // A stored hierarchy is measured as it is, violations and all: stats is how a user checks a file. Only
     // --type-weight (which weighs the cost) applies to it.
-    BuilderFlags building = args.builder;
-    building.type_weights.clear();
-    if (model->hierarchy && building.steer_a_build())
-        fmt::print(stderr, "hbvh: warning: {} stores a hierarchy, which is measured as it is: -a, --quality, --types, "
-                           "--objective, --refine, --treelet-units and --time-limit apply to primitive sets\n",
-                   model->source);
+    warn_if_build_flags_unused(model.value(), args.builder, /*measured=*/true);
     Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : request->run(model->primitives);
     if (!bvh) return report_error(bvh.error());
     const std::vector<ContainmentViolation> violations = containment_violations(bvh.value());
