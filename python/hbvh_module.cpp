@@ -22,8 +22,6 @@
 #include <utility>
 #include <vector>
 
-#include <Eigen/SVD>
-
 #include "hbvh/hbvh.hpp"
 
 namespace py = pybind11;
@@ -85,20 +83,18 @@ DoubleArray numbers_array(const py::handle& object, const char* name) {
 }
 
 /// Whether `object`'s numbers are floats narrower than double: a float32 rotation is off a rotation by its
-/// rounding (a few 1e-8), far beyond the library's 1e-9, and is replaced by the nearest one (nearest_rotation).
+/// rounding (a few 1e-8), far beyond the library's 1e-9, and is replaced by the nearest one (float32_rotation_repaired).
 bool narrow_floats(const py::handle& object) {
     const py::array raw = py::array::ensure(object);
     return raw && raw.dtype().kind() == 'f' && raw.dtype().itemsize() < 8;
 }
 
-/// The proper rotation nearest `m` (the orthogonal factor of its polar decomposition) when `m` is one up to
-/// single-precision rounding (|R^T R - I| <= 1e-5, det > 0); `m` itself otherwise, which validation then refuses
-/// in its own words.
-Mat3 nearest_rotation(const Mat3& m) {
+/// The proper rotation nearest `m` (hbvh::nearest_rotation) when `m` is one up to single-precision rounding
+/// (|R^T R - I| <= 1e-5, det > 0); `m` itself otherwise, which validation then refuses in its own words.
+Mat3 float32_rotation_repaired(const Mat3& m) {
     if (!m.allFinite() || !((m.transpose() * m - Mat3::Identity()).cwiseAbs().maxCoeff() <= 1e-5) || !(m.determinant() > 0.0))
         return m;
-    const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    return svd.matrixU() * svd.matrixV().transpose();
+    return nearest_rotation(m);
 }
 
 /// `object` as a C-contiguous double array of shape `shape` (-1: any length, the same N for every argument).
@@ -174,7 +170,7 @@ Primitives make_boxes(const py::handle& centers_in, const py::handle& half_exten
     for (py::ssize_t i = 0; i < n; ++i) {
         const Vec3 center = vec3_at(centers, i);
         const Vec3 half = vec3_at(half_extents, i);
-        const auto rotation = [&] { return round_rotations ? nearest_rotation(mat3_at(*rotations, i)) : mat3_at(*rotations, i); };
+        const auto rotation = [&] { return round_rotations ? float32_rotation_repaired(mat3_at(*rotations, i)) : mat3_at(*rotations, i); };
         // Without rotations a box is axis-aligned: an Aabb primitive, as in the survey's XML.
         BoundingVolume volume = rotations ? BoundingVolume(Obb{center, rotation(), half})
                                           : BoundingVolume(Aabb{center - half, center + half});
@@ -236,7 +232,7 @@ RigidTransform pose_of(const py::handle& object, const char* name) {
         const DoubleArray rotation = checked_array(parts[0], name, {3, 3}, unused);
         const DoubleArray translation = checked_array(parts[1], name, {3}, unused);
         const Mat3 r = mat3_at(rotation, 0);
-        return {narrow_floats(parts[0]) ? nearest_rotation(r) : r, vec3_at(translation, 0)};
+        return {narrow_floats(parts[0]) ? float32_rotation_repaired(r) : r, vec3_at(translation, 0)};
     }
     const DoubleArray matrix = checked_array(object, name, {4, 4}, unused);
     const double* m = matrix.data();
@@ -247,7 +243,7 @@ RigidTransform pose_of(const py::handle& object, const char* name) {
         for (int c = 0; c < 3; ++c) pose.rotation(r, c) = m[4 * r + c];
         pose.translation(r) = m[4 * r + 3];
     }
-    if (narrow_floats(object)) pose.rotation = nearest_rotation(pose.rotation);
+    if (narrow_floats(object)) pose.rotation = float32_rotation_repaired(pose.rotation);
     return pose;
 }
 
@@ -475,7 +471,7 @@ py::list collide_many(const Hierarchy& a, const Hierarchy& b, const py::handle& 
             for (int c = 0; c < 3; ++c) transforms[static_cast<std::size_t>(k)].rotation(r, c) = p[4 * r + c];
             transforms[static_cast<std::size_t>(k)].translation(r) = p[4 * r + 3];
         }
-        if (round_rotations) transforms[static_cast<std::size_t>(k)].rotation = nearest_rotation(transforms[static_cast<std::size_t>(k)].rotation);
+        if (round_rotations) transforms[static_cast<std::size_t>(k)].rotation = float32_rotation_repaired(transforms[static_cast<std::size_t>(k)].rotation);
     }
     std::vector<CollideResult> results(transforms.size());
     {

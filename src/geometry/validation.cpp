@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <limits>
 
+#include <Eigen/SVD>
+
 namespace hbvh {
 namespace {
 
@@ -65,6 +67,11 @@ bool is_rotation(const Mat3& r) {
 }
 
 }  // namespace
+
+Mat3 nearest_rotation(const Mat3& m) {
+    const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    return svd.matrixU() * svd.matrixV().transpose();
+}
 
 std::string rotation_problem(const Mat3& rotation) {
     if (is_rotation(rotation)) return {};

@@ -23,7 +23,6 @@
 #include <mutex>
 #include <utility>
 
-#include <Eigen/SVD>
 #include <pugixml.hpp>
 
 #include "hbvh/assert.hpp"
@@ -710,10 +709,8 @@ Result<Mat3> Reader::read_orientation(const pugi::xml_node& element, const pugi:
     // bit for bit, so that reading a file hbvh wrote gives back its volumes and a rewrite is the same file
     // (replacing every matrix by its polar factor changed the last bits of each OBB on every pass).
     if (rotation_problem(m).empty()) return m;
-    // Polar decomposition M = (U V^T)(V S V^T): U V^T is the rotation nearest to M in the Frobenius norm.
-    // det(M) > 0 and S near 1 make det(U V^T) = +1, so this is a proper rotation.
-    const Eigen::JacobiSVD<Mat3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    return Mat3(svd.matrixU() * svd.matrixV().transpose());
+    // det(M) > 0 and R^T R near I (checked above) make the polar factor a proper rotation.
+    return nearest_rotation(m);
 }
 
 // Writing. The text is what pugixml's save(format_indent, two spaces) wrote when the writer built a DOM:

@@ -122,6 +122,23 @@ TEST(ValidatePose, TheQuickCheckAgreesWithTheWordedOne) {
     }
 }
 
+// nearest_rotation against its definition: a rounded rotation comes back a proper rotation, no further from the
+// rounded matrix (Frobenius) than the rotation it was rounded from, nor than that one turned a little either way.
+TEST(NearestRotation, IsARotationNoFurtherThanTheOneRoundedOrItsNeighbours) {
+    SplitMix64 rng(41);
+    for (int k = 0; k < 2000; ++k) {
+        const Mat3 exact = rng.rotation();
+        Mat3 rounded = exact;
+        for (int e = 0; e < 9; ++e) rounded(e / 3, e % 3) += rng.uniform(-1e-3, 1e-3);
+        const Mat3 nearest = nearest_rotation(rounded);
+        EXPECT_TRUE(rotation_problem(nearest).empty()) << k;
+        const double distance = (nearest - rounded).norm();
+        EXPECT_LE(distance, (exact - rounded).norm() + 1e-15) << k;
+        for (const Mat3& turn : {Mat3(Eigen::AngleAxisd(1e-4, Vec3::UnitX())), Mat3(Eigen::AngleAxisd(-1e-4, Vec3::UnitZ()))})
+            EXPECT_LE(distance, (nearest * turn - rounded).norm() + 1e-15) << k;
+    }
+}
+
 TEST(ValidatePose, AgreesWithTheFullProductAwayFromTheTolerance) {
     // The check computes six dot products of the columns, not R^T R; an independent oracle: Eigen's full
     // product and determinant, on perturbed rotations (and a non-finite entry in every position). Where the

@@ -20,6 +20,10 @@ inline constexpr double rotation_tolerance = 1e-9;
 
 /// Empty when `rotation` is a proper rotation within rotation_tolerance; otherwise the problem in words.
 [[nodiscard]] std::string rotation_problem(const Mat3& rotation);
+/// The rotation nearest `m` in the Frobenius norm: the orthogonal factor U V^T of its polar decomposition (from
+/// the SVD m = U S V^T). For a matrix meant as a rotation but rounded (a file's few digits, float32): with
+/// det(m) > 0 and S near 1, U V^T is a proper rotation. Callers decide first how far from one `m` may be.
+[[nodiscard]] Mat3 nearest_rotation(const Mat3& m);
 /// Empty when `volume` is usable geometry; otherwise the problem in words ("radius -1 is negative", ...).
 /// Refused: non-finite numbers (also derived ones: a box's extent, a capsule's length), sizes < 0 and
 /// subnormal sizes (they vanish in the first product), rotations that are no proper rotation.
