@@ -10,15 +10,7 @@ namespace {
 // Below this length a direction carries no information; MuJoCo uses a similar cut-off (mjMINVAL).
 constexpr double tiny_length = 1e-14;
 
-/// The length of `v`: the plain norm where its square neither overflows nor underflows (the same bits as always),
-/// else Eigen's stableNorm, which scales before it squares: a quaternion or axis of 1e160 parts is as valid as one
-/// of 1, and the plain norm overflowed there to infinity, which divided every part to 0 (the identity, or a
-/// matrix that is no rotation).
-template <class Vector>
-double length_of(const Vector& v) {
-    const double plain = v.norm();
-    return std::isfinite(plain) && plain > 1e-150 ? plain : v.stableNorm();
-}
+using detail::length_of;  // a quaternion or axis of 1e160 parts is as valid as one of 1
 
 }  // namespace
 

@@ -12,6 +12,17 @@ namespace hbvh {
 using Vec3 = Eigen::Vector3d;
 using Mat3 = Eigen::Matrix3d;
 
+namespace detail {
+/// The length of `v`: the plain norm where its square neither overflows nor underflows (the same bits as always),
+/// else Eigen's stableNorm, which scales before it squares. Parts of 1e160 or 1e-300 are as valid a direction or
+/// quaternion as parts of 1, and the plain norm made them infinite or 0 (divided by, every part became 0 or NaN).
+template <class Vector>
+[[nodiscard]] double length_of(const Vector& v) {
+    const double plain = v.norm();
+    return std::isfinite(plain) && plain > 1e-150 ? plain : v.stableNorm();
+}
+}  // namespace detail
+
 /// A rigid motion: x -> rotation * x + translation. rotation must be a proper rotation (det +1).
 struct RigidTransform {
     Mat3 rotation = Mat3::Identity();
@@ -33,10 +44,7 @@ struct RigidTransform {
     [[nodiscard]] static RigidTransform from_quaternion(double w, double x, double y, double z,
                                                         const Vec3& translation = Vec3::Zero()) {
         const Eigen::Quaterniond q(w, x, y, z);
-        // Where the plain norm's square overflows or underflows (components of 1e300 or 1e-300, which came out
-        // refused as non-finite), the norm is scaled before it squares (stableNorm); elsewhere it is the plain one.
-        const double plain = q.norm();
-        const double norm = std::isfinite(plain) && plain > 1e-150 ? plain : q.coeffs().stableNorm();
+        const double norm = detail::length_of(q.coeffs());  // components of 1e300 or 1e-300 too
         if (!(norm > 0.0) || !std::isfinite(norm))
             return {Mat3::Constant(std::numeric_limits<double>::quiet_NaN()), translation};
         return {Eigen::Quaterniond(q.coeffs() / norm).toRotationMatrix(), translation};
