@@ -93,6 +93,15 @@ Status check_numbers(const XmlSource& source, const pugi::xml_node& element, pug
     return Ok{};
 }
 
+// An <origin>'s xyz and rpy (each optional), checked and written back as check_numbers does.
+Status check_origin(const XmlSource& source, const pugi::xml_node& origin, const pugi::xml_node& patched_origin) {
+    if (!origin) return Ok{};
+    for (const char* attribute : {"xyz", "rpy"})
+        if (Status checked = check_numbers(source, origin, patched_origin, {attribute, 3, false, false}); !checked)
+            return checked;
+    return Ok{};
+}
+
 // The element named `name` (a link or joint) to locate an urdfdom message in the file; null when not found.
 pugi::xml_node element_named_in(const pugi::xml_node& robot, const std::string& message) {
     for (const pugi::xml_node& element : robot.children()) {
@@ -185,12 +194,8 @@ private:
     Status check_joint_origins(const pugi::xml_node& robot, const pugi::xml_node& patched_robot) {
         pugi::xml_node patched_joint = patched_robot.child("joint");
         for (const pugi::xml_node& joint : robot.children("joint")) {
-            if (const pugi::xml_node origin = joint.child("origin"))
-                for (const char* attribute : {"xyz", "rpy"})
-                    if (Status checked = check_numbers(*source_, origin, patched_joint.child("origin"),
-                                                       {attribute, 3, false, false});
-                        !checked)
-                        return checked;
+            if (Status checked = check_origin(*source_, joint.child("origin"), patched_joint.child("origin")); !checked)
+                return checked;
             patched_joint = patched_joint.next_sibling("joint");
         }
         return Ok{};
@@ -232,13 +237,9 @@ private:
                     continue;
                 }
                 // The collision's numbers, with their lines (a capsule's are read below).
-                const pugi::xml_node origin = collision.child("origin");
-                for (const char* attribute : {"xyz", "rpy"})
-                    if (origin)
-                        if (Status checked = check_numbers(*source_, origin, patched_collision.child("origin"),
-                                                           {attribute, 3, false, false});
-                            !checked)
-                            return checked;
+                if (Status checked = check_origin(*source_, collision.child("origin"), patched_collision.child("origin"));
+                    !checked)
+                    return checked;
                 const pugi::xml_node patched_shape = patched_collision.child("geometry").child(shape_element.name());
                 std::vector<NumberRule> rules;
                 if (shape_name == "box") rules = {{"size", 3, true, true}};
