@@ -9,7 +9,7 @@
 #include "../fit/frames.hpp"
 #include "../memory/huge_pages.hpp"
 #include "../tree/binary_decoding.hpp"
-#include "../tree/containment_error.hpp"
+#include "../tree/containment.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
 #include "hbvh/tree/binary_format.hpp"
@@ -205,19 +205,10 @@ Status validate(const QueryTree& tree, double relative_tolerance) {
         const QueryNode& node = tree.nodes()[i];
         if (node.child_count == 0) continue;
         const BoundingVolume& volume = tree.volume(i);
-        const double tolerance = containment_tolerance(volume, relative_tolerance);
-        double worst = tolerance;
-        std::optional<std::uint32_t> worst_primitive;
-        for (const std::uint32_t leaf : tree.leaves().subspan(node.leaf_begin, node.leaf_count)) {
-            spheres.clear();
-            append_generating_spheres(tree.volume(leaf), spheres);
-            const std::uint32_t primitive = tree.nodes()[leaf].primitive;
-            for (const Sphere& s : spheres)
-                if (const double reach = protrusion(volume, s);
-                    reach > worst || (worst_primitive && reach == worst && primitive < *worst_primitive))
-                    worst = reach, worst_primitive = primitive;
-        }
-        if (worst_primitive) return detail::containment_error(i, type_of(volume), *worst_primitive, worst);
+        detail::WorstReach worst(volume, containment_tolerance(volume, relative_tolerance), spheres);
+        for (const std::uint32_t leaf : tree.leaves().subspan(node.leaf_begin, node.leaf_count))
+            worst.add(tree.nodes()[leaf].primitive, tree.volume(leaf));
+        if (worst.primitive()) return detail::containment_error(i, type_of(volume), *worst.primitive(), worst.reach());
     }
     return Ok{};
 }

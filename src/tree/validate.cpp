@@ -10,7 +10,7 @@
 #include <tbb/parallel_invoke.h>
 
 #include "../memory/huge_pages.hpp"
-#include "containment_error.hpp"
+#include "containment.hpp"
 #include "hbvh/geometry/validation.hpp"
 
 namespace hbvh {
@@ -104,28 +104,16 @@ std::vector<ContainmentViolation> containment_violations(const Bvh& bvh, double 
     std::vector<std::uint32_t> stack;
     for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
         const Node& node = bvh.nodes[i];
-        const double tolerance = containment_tolerance(node.volume, relative_tolerance);
-        ContainmentViolation worst{i, 0, 0.0};
-        bool violated = false;
+        detail::WorstReach worst(node.volume, containment_tolerance(node.volume, relative_tolerance), spheres);
         // The primitives below node i: a walk of its subtree (structure checked, so it ends).
         stack.assign(1, i);
         while (!stack.empty()) {
             const Node& below = bvh.nodes[stack.back()];
             stack.pop_back();
             for (std::uint32_t c = 0; c < below.child_count; ++c) stack.push_back(below.first_child + c);
-            if (!below.is_leaf()) continue;
-            spheres.clear();
-            append_generating_spheres(bvh.primitives[below.primitive].volume, spheres);
-            for (const Sphere& s : spheres) {
-                const double reach = protrusion(node.volume, s);
-                if (reach > tolerance && (!violated || reach > worst.protrusion ||
-                                          (reach == worst.protrusion && below.primitive < worst.primitive))) {
-                    worst = {i, below.primitive, reach};
-                    violated = true;
-                }
-            }
+            if (below.is_leaf()) worst.add(below.primitive, bvh.primitives[below.primitive].volume);
         }
-        if (violated) violations.push_back(worst);
+        if (worst.primitive()) violations.push_back({i, *worst.primitive(), worst.reach()});
     }
     return violations;
 }
