@@ -65,10 +65,12 @@ HBVH_WIDE_CLONES void solve_subset(detail::SubsetTables& t, std::span<const doub
         for (std::uint32_t k = 0; k < remainder_size; ++k) row[k + 1] = std::min(row[k + 1], block_cost + from[k]);
         if (sub == 0) break;
     }
-    // best(S) = min over k >= 2 of k·vol(S) + P_k(S); the first (smallest) k wins ties.
+    // best(S) = min over k >= 2 of k·vol(S) + P_k(S); the first (smallest) k wins ties. Two children stand until
+    // a candidate is cheaper, so that S has a valid split even where every price is infinite (volumes that
+    // overflow far from the origin): with none recorded, plan_of queued S as its own child without end.
     const double w = volume[s];
     double best = infinite_cost;
-    std::uint8_t arg = 0;
+    std::uint8_t arg = 2;
     for (std::uint32_t k = 2; k <= size; ++k) {
         const double candidate = static_cast<double>(k) * w + row[k - 1];
         if (candidate < best) {
@@ -126,7 +128,9 @@ std::vector<std::uint32_t> blocks_of(const detail::SubsetTables& t, std::uint32_
             }
             if (sub == 0) break;
         }
-        HBVH_ASSERT(chosen != 0);
+        // No block matches the target only where the prices are not numbers (NaN from inf - inf): any split
+        // of S is then as good as another, and the lowest element alone keeps every block a proper subset.
+        if (chosen == 0) chosen = low;
         blocks.push_back(chosen);
         s ^= chosen;
         --k;
