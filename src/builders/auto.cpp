@@ -173,11 +173,16 @@ Result<Bvh> auto_tree(std::span<const Primitive> primitives, const BuildContext&
     // The callback is called from the calling thread only (BuildContext::progress), so once the members are done.
     context.report_progress(static_cast<double>(members.size()) / static_cast<double>(members.size() + 1));
 
-    // The cheapest tree wins, the first in the list on ties. An unrefined tree is no cheaper than the refined
-    // ones (they were the cheapest before refinement, which never adds cost), so only they compete when any is.
+    // The cheapest tree wins; on equal cost the lower one (fewer levels for a query to descend), then the first
+    // in the list. A tiled floor of flat boxes costs 0 whatever the tree, and the first member's was a chain of
+    // height n - 1. An unrefined tree is no cheaper than the refined ones (they were the cheapest before
+    // refinement, which never adds cost), so only they compete when any is.
     const auto competing_end = built.begin() + static_cast<std::ptrdiff_t>(std::max<std::size_t>(refine, 1));
+    std::vector<std::uint32_t> heights(members.size(), 0);
+    for (auto it = built.begin(); it != competing_end; ++it) heights[*it] = height(**outcomes[*it].tree);
     const std::size_t winner = *std::min_element(built.begin(), competing_end, [&](std::size_t a, std::size_t b) {
-        return outcomes[a].cost != outcomes[b].cost ? outcomes[a].cost < outcomes[b].cost : a < b;
+        if (outcomes[a].cost != outcomes[b].cost) return outcomes[a].cost < outcomes[b].cost;
+        return heights[a] != heights[b] ? heights[a] < heights[b] : a < b;
     });
     std::string costs;
     std::string skipped;

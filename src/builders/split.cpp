@@ -169,6 +169,7 @@ private:
             frame = fit_obb_covariance(spheres);
         }
         double best_cost = std::numeric_limits<double>::infinity();
+        std::size_t best_imbalance = count;
         int best_axis = 0;
         std::size_t best_cut = count / 2;
         std::vector<double> prefix(count), suffix(count);
@@ -178,9 +179,13 @@ private:
             for (std::size_t left = 1; left < count; ++left) {
                 const double cost = static_cast<double>(left) * prefix[left - 1] +
                                     static_cast<double>(count - left) * suffix[left];
-                // Strict '<': on equal cost the earlier axis and the earlier cut win, both fixed by geometry.
-                if (cost < best_cost) {
+                // On equal cost the more even cut wins, then the earlier axis and the earlier cut, all fixed by
+                // geometry. Flat or point-like primitives cost 0 under any cut (a tiled floor), and taking the
+                // first cut there peeled one primitive a level: a chain of height n - 1.
+                const std::size_t imbalance = 2 * left > count ? 2 * left - count : count - 2 * left;
+                if (cost < best_cost || (cost == best_cost && imbalance < best_imbalance)) {
                     best_cost = cost;
+                    best_imbalance = imbalance;
                     best_axis = axis;
                     best_cut = left;
                 }

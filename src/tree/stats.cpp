@@ -39,6 +39,18 @@ double cost(const Bvh& bvh, const VolumePolicy& policy) {
     return total;
 }
 
+std::vector<std::uint32_t> node_depths(const Bvh& bvh) {
+    std::vector<std::uint32_t> depth(bvh.nodes.size(), 0);
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i)
+        for (std::uint32_t c = 0; c < bvh.nodes[i].child_count; ++c) depth[bvh.nodes[i].first_child + c] = depth[i] + 1;
+    return depth;
+}
+
+std::uint32_t height(const Bvh& bvh) {
+    const std::vector<std::uint32_t> depth = node_depths(bvh);
+    return depth.empty() ? 0 : *std::max_element(depth.begin(), depth.end());
+}
+
 Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
     Stats stats;
     stats.nodes = static_cast<std::uint32_t>(bvh.nodes.size());
@@ -49,8 +61,7 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
     SummaryBuilder branching, tightness, leaf_depth;
     double overlap_volume = 0.0, sibling_volume = 0.0;
 
-    // Depths follow from the breadth-first layout: a child is deeper than its parent by one.
-    std::vector<std::uint32_t> depth(bvh.nodes.size(), 0);
+    const std::vector<std::uint32_t> depth = node_depths(bvh);
     std::vector<Aabb> child_boxes;
     for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
         const Node& node = bvh.nodes[i];
@@ -67,7 +78,6 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
         child_boxes.clear();
         for (std::uint32_t c = 0; c < node.child_count; ++c) {
             const Node& child = bvh.nodes[node.first_child + c];
-            depth[node.first_child + c] = depth[i] + 1;
             children_volume += volume(child.volume);
             child_boxes.push_back(world_aabb(child.volume));
             sibling_volume += child_boxes.back().volume();

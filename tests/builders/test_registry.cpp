@@ -136,6 +136,31 @@ TEST(Registry, EveryBuilderSurvivesVolumesThatOverflowFarFromTheOrigin) {
     }
 }
 
+// A tiled floor: 200 flat boxes cost 0 under Eq. 2 whatever the tree, so only tie-breaks shape it. split took the
+// first cut of equal cost and peeled one tile a level, and auto kept the first member's tree at equal cost: both
+// gave a chain of height 199, which a query descends tile by tile (a user's review, 2026-12-07). The more even cut
+// and the lower tree now win ties. (insertion and insertion-haber still chain here: docs/bad-input.md.)
+TEST(Registry, SplitAndAutoGiveABalancedTreeOverAFloorOfFlatTiles) {
+    std::vector<Primitive> floor;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 10; ++j) floor.push_back({Aabb{Vec3(i, j, 0.0), Vec3(i + 1.0, j + 1.0, 0.0)}, ""});
+    for (const Algorithm algorithm : {Algorithm::split, Algorithm::automatic}) {
+        const Bvh tree = build(floor, algorithm).value();
+        EXPECT_EQ(cost(tree), 0.0);
+        // The longest root-to-leaf path by a walk of the tree, against height()'s breadth-first depths.
+        std::uint32_t longest = 0;
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> walk{{0, 0}};
+        while (!walk.empty()) {
+            const auto [node, depth] = walk.back();
+            walk.pop_back();
+            longest = std::max(longest, depth);
+            for (std::uint32_t c = 0; c < tree.nodes[node].child_count; ++c) walk.push_back({tree.nodes[node].first_child + c, depth + 1});
+        }
+        EXPECT_EQ(height(tree), longest);
+        EXPECT_LE(longest, 16u) << to_string(algorithm);  // 2 x ceil(log2 200)
+    }
+}
+
 TEST(Registry, EveryBuilderRefusesAPolicyItCannotWorkWith) {
     // A NaN weight made binned recurse without end (a crash) and optimal and auto loop; no allowed kind gave
     // trees of empty AABBs that enclose nothing.

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <vector>
 
 #include "hbvh/fit/volume_policy.hpp"
 #include "hbvh/tree/bvh.hpp"
@@ -36,5 +37,9 @@ struct Stats {
 /// Eq. 2 with the policy's per-kind weights and node measure (weights 1 and volume give the survey's cost).
 [[nodiscard]] double cost(const Bvh& bvh, const VolumePolicy& policy = {});
 [[nodiscard]] Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy = {});
+/// Each node's depth (the root's 0), from the breadth-first layout: a child is deeper than its parent by one.
+[[nodiscard]] std::vector<std::uint32_t> node_depths(const Bvh& bvh);
+/// Edges on the longest root-to-leaf path (Stats::height) alone, in one pass.
+[[nodiscard]] std::uint32_t height(const Bvh& bvh);
 
 }  // namespace hbvh
