@@ -219,6 +219,19 @@ Status write_file_atomic(const std::filesystem::path& path, std::string_view con
             return replace_file(resolved, content, name);
         }
     }
+    // A dangling symbolic link: the file it names is created and the link kept, as a shell's `>` does; replacing
+    // the link by a file would cut whatever the link was there for (a configuration's fixed path, say).
+    if (struct stat link {}; ::lstat(path.c_str(), &link) == 0 && S_ISLNK(link.st_mode)) {
+        std::filesystem::path resolved = path;
+        std::error_code error;
+        for (int hops = 0; std::filesystem::is_symlink(resolved, error); ++hops) {
+            if (hops == 40) return Error("cannot follow the symbolic link: too many levels of links", name);
+            const std::filesystem::path next = std::filesystem::read_symlink(resolved, error);
+            if (error) return Error("cannot follow the symbolic link: " + error.message(), name);
+            resolved = next.is_absolute() ? next : resolved.parent_path() / next;
+        }
+        return replace_file(resolved, content, name);
+    }
     return replace_file(path, content, name);
 }
 

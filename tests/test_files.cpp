@@ -159,7 +159,8 @@ TEST_F(FileTest, ALinkToAFileIsFollowedAndKept) {
     EXPECT_EQ(*read_text_file(file), "new");
     EXPECT_EQ(entries(), (std::vector<std::string>{"file", "link"}));
 
-    // A link to a directory is refused and stays; a dangling one is replaced by the file.
+    // A link to a directory is refused and stays; a dangling one keeps its place and the file it names is made,
+    // through a chain of relative links too (as a shell's `>` does).
     fs::create_directory(directory_ / "folder");
     fs::create_symlink(directory_ / "folder", directory_ / "to_folder");
     const Status refused = write_file_atomic(directory_ / "to_folder", "x");
@@ -169,7 +170,18 @@ TEST_F(FileTest, ALinkToAFileIsFollowedAndKept) {
     EXPECT_TRUE(fs::is_empty(directory_ / "folder"));
     fs::create_symlink(directory_ / "nothing", directory_ / "dangling");
     ASSERT_TRUE(write_file_atomic(directory_ / "dangling", "made"));
-    EXPECT_EQ(*read_text_file(directory_ / "dangling"), "made");
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(directory_ / "dangling")));
+    EXPECT_EQ(*read_text_file(directory_ / "nothing"), "made");
+    fs::create_directory(directory_ / "sub");
+    fs::create_symlink("sub/hop", directory_ / "first");
+    fs::create_symlink("../target", directory_ / "sub" / "hop");
+    ASSERT_TRUE(write_file_atomic(directory_ / "first", "chained"));
+    EXPECT_TRUE(fs::is_symlink(fs::symlink_status(directory_ / "first")));
+    EXPECT_EQ(*read_text_file(directory_ / "target"), "chained");
+    // A loop of links is an error, not a hang.
+    fs::create_symlink("loop_b", directory_ / "loop_a");
+    fs::create_symlink("loop_a", directory_ / "loop_b");
+    EXPECT_FALSE(write_file_atomic(directory_ / "loop_a", "x"));
 }
 
 TEST_F(FileTest, TheProcesssOwnStandardOutputIsWrittenThroughItsDescriptor) {

@@ -20,7 +20,7 @@ namespace hbvh {
 /// see either the old file or the complete new one. On any failure the temporary file is removed and
 /// `path` is left as it was. An existing file's permission bits are kept; a new file gets the usual
 /// 0666 & ~umask. A symbolic link to a regular file is followed: the file it names is replaced and the link
-/// kept (a dangling link is replaced by the file); a link to a directory is refused. Two kinds of path are
+/// kept (a dangling link keeps its place too, and the file it names is made); a link to a directory is refused. Two kinds of path are
 /// written into instead of replaced, since there is nothing there to replace atomically: the process's own
 /// standard output or error, by whatever name (`/dev/stdout`, `/dev/fd/1`, the file the shell redirected it
 /// to), through that descriptor; and a device, fifo or socket (`/dev/null`, a pipe). POSIX only.

@@ -270,3 +270,13 @@ configure_file(${PROJECT_SOURCE_DIR}/data/models/chair.xml ${HBVH_CLI_OUT}/chair
 hbvh_cli_test(simulate_format 0 "" simulate ${HBVH_CLI_OUT}/chair_named.txt --format xml -a fast --collisions 5)
 hbvh_cli_test(collide_format 0 "" collide ${HBVH_CLI_OUT}/chair_named.txt ${HBVH_CLI_OUT}/chair_named.txt --format xml
               -a fast --pose-b "0.3 0 0")
+
+# An empty output name (an unset shell variable) is a usage error, exit 2, in every command that writes a file; it
+# was exit 1 with "not a file name" and no name. CLI11 reads `--output=` as an empty value.
+foreach(command build convert generate export view calibrate)
+  set(input ${PROJECT_SOURCE_DIR}/data/models/chair.xml)
+  if(command STREQUAL "generate" OR command STREQUAL "calibrate")
+    set(input "")
+  endif()
+  hbvh_cli_test(empty_output_name_${command} 2 "output" ${command} ${input} --output=)
+endforeach()

@@ -172,7 +172,8 @@ void add_calibrate_command(CLI::App& app, Command& command) {
     sub->add_option("--passes", args->passes, "Timed passes over the queries; the fastest counts")
         ->capture_default_str()
         ->check(whole_number(1, 1000));
-    sub->add_option("-o,--output", args->output, "Write the weights (type=weight,...) to this file");
+    sub->add_option("-o,--output", args->output, "Write the weights (type=weight,...) to this file")
+        ->check(output_name());
     sub->footer("Example: hbvh calibrate -o weights.txt && hbvh build model.xml --type-weight @weights.txt");
     sub->callback([&command, args] { command = [args] { return run_calibrate(*args); }; });
 }

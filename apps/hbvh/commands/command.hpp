@@ -60,6 +60,8 @@ void report_warnings(const std::vector<std::string>& warnings);
 /// Refuses an output name whose extension is another format's (.gltf, .obj, .dot, .html, .urdf, ...) for the
 /// commands that write survey XML or, for .hbvh, the binary format: XML written into x.gltf was read as glTF later.
 [[nodiscard]] CLI::Validator hierarchy_output_name();
+/// Refuses an empty output name (a usage error, exit 2).
+[[nodiscard]] CLI::Validator output_name();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.
 struct BuildRequest {

@@ -77,9 +77,17 @@ CLI::Validator whole_number(std::uint64_t least, std::uint64_t most) {
         "[" + std::to_string(least) + " - " + std::to_string(most) + "]");
 }
 
+CLI::Validator output_name() {
+    // An empty name is a slip of the command line (an unset shell variable), not a file that cannot be written.
+    return CLI::Validator(
+        [](const std::string& name) { return name.empty() ? std::string("the output name is empty") : std::string(); },
+        "OUTPUT");
+}
+
 CLI::Validator hierarchy_output_name() {
     return CLI::Validator(
         [](const std::string& name) {
+            if (name.empty()) return std::string("the output name is empty");
             static constexpr std::string_view others[] = {".gltf", ".glb", ".obj", ".stl", ".ply", ".fbx", ".dae",
                                                           ".dot", ".svg", ".html", ".htm", ".urdf", ".json"};
             const std::string extension = lower_case_extension(name);

@@ -139,7 +139,8 @@ void add_export_command(CLI::App& app, Command& command) {
         "export", "Pictures of a hierarchy: its levels as glTF 2.0 meshes, or its tree as Graphviz DOT / SVG");
     sub->add_option("file", args->input, "Hierarchy file, or a primitive set (built first with -a)")->required();
     sub->add_option("-o,--output", args->output, "Output .gltf, .dot or .svg, or - for stdout (with --format)")
-        ->required();
+        ->required()
+        ->check(output_name());
     sub->add_option("--format", args->format, "gltf, dot or svg, when the output's extension does not tell")
         ->check(CLI::IsMember({"gltf", "dot", "svg"}));
     sub->add_option("--input-format", args->input_format, "Input format when the extension does not tell");

@@ -49,7 +49,9 @@ void add_view_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<ViewArguments>();
     CLI::App* sub = app.add_subcommand("view", "An offline HTML page showing a hierarchy level by level");
     sub->add_option("file", args->input, "Hierarchy file, or a primitive set (built first with -a)")->required();
-    sub->add_option("-o,--output", args->output, "Output HTML page, or - for stdout")->capture_default_str();
+    sub->add_option("-o,--output", args->output, "Output HTML page, or - for stdout")
+        ->capture_default_str()
+        ->check(output_name());
     sub->add_option("--format", args->format, "Input format when the extension does not tell");
     sub->add_option("--title", args->title, "Page title (default: the input's file name)");
     args->builder.add_to(*sub);
