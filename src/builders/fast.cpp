@@ -173,9 +173,15 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
         for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
         early.start(std::move(all));
     }
+    const std::size_t notes_before = context.report != nullptr ? context.report->notes.size() : 0;
     Result<Bvh> built =
         build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
                                                                 : BinnedOptions{}.max_children, options.lookahead_candidates));
+    // binned's notes ("binned: time limit reached ...") are the preset's first step's: a user who asked for fast
+    // reads fast's name first.
+    if (context.report != nullptr)
+        for (std::size_t i = notes_before; i < context.report->notes.size(); ++i)
+            context.report->notes[i].insert(0, "fast: the first step, ");
     if (!built || context.expired()) return built;
     Bvh& bvh = *built;
     // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is

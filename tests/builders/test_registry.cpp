@@ -94,6 +94,11 @@ TEST(Registry, EveryBuilderHonoursAPassedDeadlineWithAValidTree) {
         ASSERT_TRUE(built.has_value()) << row.name << ": " << built.error().to_string();
         test_support::expect_tree_properties(primitives, *built);
         EXPECT_TRUE(report.budget_hit) << row.name << " did not report the passed deadline";
+        // The note says so under the name the user asked for (fast's named only its first step, binned).
+        const std::string own = std::string(row.name) + ": ";
+        EXPECT_TRUE(std::any_of(report.notes.begin(), report.notes.end(),
+                                [&](const std::string& note) { return note.starts_with(own); }))
+            << row.name << " left no note of its own";
     }
 }
 
