@@ -18,6 +18,8 @@
 #include "treelet_fit_cache.hpp"
 #include "../tree/collapse.hpp"
 #include "hbvh/builders/binned.hpp"
+#include "hbvh/builders/insertion.hpp"
+#include "hbvh/builders/insertion_haber.hpp"
 #include "hbvh/builders/build.hpp"
 #include "hbvh/assert.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -36,11 +38,25 @@ struct MemberOutcome {
 
 /// A member's tree. binned's net against split is off: up to its limit split is in the same portfolio, so the
 /// net would only build split's tree a second time.
+/// The insertions' exact refits are capped (auto_insertion_refit_budget): on input sorted along a line they build
+/// a chain, and their refits grow cubically with n.
 Result<Bvh> build_member(std::span<const Primitive> primitives, Algorithm algorithm, const BuildContext& context) {
-    if (algorithm != Algorithm::binned) return build(primitives, algorithm, context);
-    BinnedOptions options;
-    options.guarantee_split_up_to = 0;
-    return build_binned(primitives, context, options);
+    if (algorithm == Algorithm::binned) {
+        BinnedOptions options;
+        options.guarantee_split_up_to = 0;
+        return build_binned(primitives, context, options);
+    }
+    if (algorithm == Algorithm::insertion) {
+        InsertionOptions options;
+        options.max_refit_primitives = auto_insertion_refit_budget(primitives.size());
+        return build_insertion(primitives, context, options);
+    }
+    if (algorithm == Algorithm::insertion_haber) {
+        InsertionHaberOptions options;
+        options.max_refit_primitives = auto_insertion_refit_budget(primitives.size());
+        return build_insertion_haber(primitives, context, options);
+    }
+    return build(primitives, algorithm, context);
 }
 
 /// How many of the members' trees are refined before the comparison, the cheapest unrefined ones first.
@@ -235,6 +251,12 @@ Result<Bvh> build_auto(std::span<const Primitive> primitives, const BuildContext
     no_deadline.deadline = BuildContext::Clock::time_point::max();
     return detail::guarded_build(primitives, no_deadline, "auto", 1.0,
                                  [&](const detail::Checkpoint&) { return auto_tree(primitives, context, options); });
+}
+
+std::uint64_t auto_insertion_refit_budget(std::size_t primitive_count) {
+    std::uint64_t levels = 1;
+    while ((std::uint64_t{1} << levels) < primitive_count) ++levels;
+    return auto_insertion_refit_factor * primitive_count * levels;
 }
 
 Algorithm auto_choice(std::size_t primitive_count) { return auto_portfolio(primitive_count).front(); }

@@ -61,7 +61,7 @@ Placement choose_placement(const InsertionTree& tree, std::uint32_t item) {
 }  // namespace
 
 Result<Bvh> build_insertion(std::span<const Primitive> primitives, const BuildContext& context,
-                            const InsertionOptions& /*options*/) {
+                            const InsertionOptions& options) {
     return detail::guarded_build(primitives, context, "insertion", static_cast<double>(primitives.size()),
                                  [&](const detail::Checkpoint& checkpoint) {
         // Input order is the insertion order: the identity permutation.
@@ -69,15 +69,18 @@ Result<Bvh> build_insertion(std::span<const Primitive> primitives, const BuildCo
         std::iota(order.begin(), order.end(), 0u);
         const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
         InsertionTree tree(set);
-        for (std::uint32_t local = 0; local < set.size(); ++local) {
-            checkpoint.step(local);
-            const std::uint32_t leaf = tree.make_leaf(local);
-            if (tree.root() == detail::no_node)
-                tree.attach(leaf, {});
-            else
-                tree.attach(leaf, choose_placement(tree, leaf));
-        }
-        return tree.to_bvh(primitives);
+        return detail::build_within_refit_budget(primitives, context, "insertion", options.max_refit_primitives, tree,
+                                                 [&](InsertionTree& growing) {
+            for (std::uint32_t local = 0; local < set.size(); ++local) {
+                checkpoint.step(local);
+                const std::uint32_t leaf = growing.make_leaf(local);
+                if (growing.root() == detail::no_node)
+                    growing.attach(leaf, {});
+                else
+                    growing.attach(leaf, choose_placement(growing, leaf));
+            }
+            return growing.to_bvh(primitives);
+        });
     });
 }
 

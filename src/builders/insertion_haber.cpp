@@ -231,12 +231,15 @@ Result<Bvh> build_insertion_haber(std::span<const Primitive> primitives, const B
         std::iota(order.begin(), order.end(), 0u);  // input order is the insertion order
         const detail::PrimitiveSet set(primitives, std::move(order), context.policy);
         InsertionTree tree(set);
-        for (std::uint32_t local = 0; local < set.size(); ++local) {
-            checkpoint.step(local);
-            insert(tree, tree.make_leaf(local), options);
-        }
-        Optimizer(tree, options).run(context);
-        return tree.to_bvh(primitives);
+        return detail::build_within_refit_budget(primitives, context, "insertion-haber", options.max_refit_primitives,
+                                                 tree, [&](InsertionTree& growing) {
+            for (std::uint32_t local = 0; local < set.size(); ++local) {
+                checkpoint.step(local);
+                insert(growing, growing.make_leaf(local), options);
+            }
+            Optimizer(growing, options).run(context);
+            return growing.to_bvh(primitives);
+        });
     });
 }
 

@@ -56,6 +56,8 @@ void InsertionTree::collect_primitives(std::uint32_t id, std::vector<std::uint32
 void InsertionTree::refit(std::uint32_t id) {
     std::vector<std::uint32_t> covered;
     collect_primitives(id, covered);
+    refits_->fitted += covered.size();
+    if (refits_->budget != 0 && refits_->fitted > refits_->budget) throw RefitBudgetSpent{};
     std::sort(covered.begin(), covered.end());
     nodes_[id].volume = fits_->fit(*set_, std::move(covered));
     nodes_[id].weighted_volume = set_->weighted_volume(nodes_[id].volume);

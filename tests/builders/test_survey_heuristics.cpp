@@ -9,7 +9,10 @@
 #include <string>
 #include <vector>
 
+#include "hbvh/builders/auto.hpp"
 #include "hbvh/builders/build.hpp"
+#include "hbvh/builders/insertion.hpp"
+#include "hbvh/builders/insertion_haber.hpp"
 #include "hbvh/io/xml.hpp"
 #include "hbvh/scene/generate.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -167,6 +170,44 @@ TEST(SurveyHeuristics, InsertionDependsOnInputOrder) {
             changed = std::abs(cost_of(shuffled(primitives, shuffle), algorithm) - reference) > 1e-9 * reference;
         EXPECT_TRUE(changed) << to_string(algorithm);
     }
+}
+
+TEST(SurveyHeuristics, AutosRefitCapStopsAChainAndSparesOrdinaryInput) {
+    // A rope of 200 capsules in order: each new one lies beyond every group, the insertion grows a chain, and its
+    // exact refits fit every ancestor again (cubic in n). Under auto's cap both insertions give up...
+    std::vector<Primitive> rope;
+    for (int i = 0; i < 200; ++i)
+        rope.push_back(Primitive{Capsule{Vec3(i - 0.4, 0.0, 0.0), Vec3(i + 0.4, 0.0, 0.0), 0.1}, ""});
+    const std::uint64_t cap = auto_insertion_refit_budget(rope.size());
+    const auto gives_up = [](const std::vector<Primitive>& primitives, Algorithm algorithm, std::uint64_t budget) {
+        BuildReport report;
+        BuildContext context;
+        context.report = &report;
+        InsertionOptions insertion;
+        insertion.max_refit_primitives = budget;
+        InsertionHaberOptions haber;
+        haber.max_refit_primitives = budget;
+        const Result<Bvh> built = algorithm == Algorithm::insertion ? build_insertion(primitives, context, insertion)
+                                                                    : build_insertion_haber(primitives, context, haber);
+        EXPECT_TRUE(built.has_value());
+        if (built) test_support::expect_tree_properties(primitives, *built);
+        return report.budget_hit;
+    };
+    for (const Algorithm algorithm : order_dependent_builders) EXPECT_TRUE(gives_up(rope, algorithm, cap)) << to_string(algorithm);
+    // ... and shuffled, the same rope stays within it, as do generated scenes of every size auto gives the
+    // insertions (11-200) and the bundled models: there the cap changes no tree.
+    std::vector<std::vector<Primitive>> ordinary{shuffled(rope, 1)};
+    for (const std::uint32_t count : {11u, 24u, 25u, 54u, 100u, 200u})
+        for (const std::uint64_t seed : {1u, 2u}) ordinary.push_back(generated_scene(count, seed, seed == 1));
+    for (const auto& file : {"cannon.xml", "chair.xml", "helicopter.xml", "tie_interceptor.xml"}) {
+        Result<XmlModel> model = read_xml_file(std::filesystem::path(HBVH_SOURCE_DIR) / "data" / "models" / file);
+        ASSERT_TRUE(model.has_value()) << file;
+        ordinary.push_back(model->primitives);
+    }
+    for (const auto& primitives : ordinary)
+        for (const Algorithm algorithm : order_dependent_builders)
+            EXPECT_FALSE(gives_up(primitives, algorithm, auto_insertion_refit_budget(primitives.size())))
+                << to_string(algorithm) << " on " << primitives.size() << " primitives";
 }
 
 /// The *.xml files of `folder`, sorted.

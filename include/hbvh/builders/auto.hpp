@@ -37,6 +37,14 @@ inline constexpr std::uint32_t auto_refine_each_max_primitives = 32;
 inline constexpr std::uint32_t auto_refine_cheapest_members = 2;
 inline constexpr std::uint32_t auto_refine_max_primitives = 200;
 
+/// The cap auto puts on its insertion members' exact refits (InsertionOptions::max_refit_primitives), in
+/// primitives fitted: auto_insertion_refit_factor n ceil(log2 n). Over the bundled and `../shared/data` models
+/// and generated scenes of 11-200 primitives the refits fitted at most 24 n ceil(log2 n) (docs/treelets.md §4); a
+/// rope of 200 capsules in order fitted 212 n ceil(log2 n), as a chain whose every ancestor is fitted again for
+/// each new capsule. Past the cap the member's tree would be a chain that another member beats anyway.
+inline constexpr std::uint64_t auto_insertion_refit_factor = 64;
+[[nodiscard]] std::uint64_t auto_insertion_refit_budget(std::size_t primitive_count);
+
 /// Knobs of build_auto.
 struct AutoOptions {
     /// Refine the winner at any size, not only up to auto_refine_max_primitives (CLI --refine).

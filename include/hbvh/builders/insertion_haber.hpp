@@ -27,6 +27,9 @@ struct InsertionHaberOptions {
     double max_tightness = 3.0;
     /// ... or a child whose volume is at least this fraction of the group's volume.
     double dominant_child_fraction = 0.7;
+    /// As InsertionOptions::max_refit_primitives: 0, no cap; else the two-level tree once the exact refits have
+    /// fitted this many primitives in all (the insertion's and the optimisation's).
+    std::uint64_t max_refit_primitives = 0;
 };
 
 /// Inserts the primitives in input order, searching the whole tree (branch and bound on the Eq. 2
