@@ -4,6 +4,7 @@
 // reference (default classes, frame composition, orientation conventions); tests check them against MuJoCo.
 #include "hbvh/io/mjcf.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstdlib>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <functional>
 #include <map>
 #include <numbers>
+#include <span>
 
 #include "hbvh/io/solid_shapes.hpp"
 #include "mjcf_orientation.hpp"
@@ -56,6 +58,7 @@ public:
         if (std::string_view(root.name()) != "mujoco")
             return source.error_at(root, "root element is <" + std::string(root.name()) + ">, expected <mujoco>");
         base_directory_ = std::filesystem::path(main_path_).parent_path();
+        included_files_[file_key(main_path_)] = "as the main file";
 
         // Stage 1: compiler settings and default classes apply wherever they appear, so read them first.
         if (Status status = for_each_child(root, [&](pugi::xml_node child) { return read_top_level(child); });
@@ -88,29 +91,57 @@ private:
                 if (Status status = visit(child); !status) return status;
                 continue;
             }
-            const XmlSource& here = source_of(child);
-            const char* file = child.attribute("file").as_string(nullptr);
-            if (file == nullptr || *file == '\0') return here.error_at(child, "<include> without a file attribute");
-            if (depth >= max_include_depth) return here.error_at(child, "includes nested too deeply (a cycle?)");
-            std::filesystem::path included = file;
-            if (included.is_relative()) included = base_directory_ / included;
-            // The name comes from the file, so it may be /dev/zero, /dev/stdin or a FIFO, which would never end.
-            std::error_code ignored;
-            if (std::filesystem::exists(included, ignored) && !std::filesystem::is_regular_file(included, ignored))
-                return here.error_at(child, "cannot include '" + std::string(file) + "': not a regular file");
-            Result<std::unique_ptr<XmlSource>> loaded = XmlSource::load(included.string());
-            if (!loaded) {
-                // Report where the include is, and why the included file failed.
-                return here.error_at(child, "cannot include '" + std::string(file) + "': " + loaded.error().to_string());
+            // Each pass over the model (defaults, then bodies) meets the same <include>: it is read on the first.
+            const XmlSource* loaded_before = nullptr;
+            if (const auto found = expanded_.find(child.internal_object()); found != expanded_.end())
+                loaded_before = found->second;
+            if (loaded_before == nullptr) {
+                Result<const XmlSource*> loaded = load_include(child, depth);
+                if (!loaded) return loaded.error();
+                loaded_before = *loaded;
             }
-            sources_.push_back(std::move(loaded.value()));
-            const XmlSource& inner = *sources_.back();
+            const XmlSource& inner = *loaded_before;
             const pugi::xml_node inner_root = inner.document().document_element();
             if (std::string_view(inner_root.name()) != "mujoco")
                 return inner.error_at(inner_root, "an included file must have the root element <mujoco>");
             if (Status status = for_each_child(inner_root, visit, depth + 1); !status) return status;
         }
         return Ok{};
+    }
+
+    // Reads the file an <include> names, once per model: MuJoCo refuses a file included twice, and without that
+    // rule 17 small files that each include the next one twice expanded 2^16 times (minutes, gigabytes).
+    Result<const XmlSource*> load_include(const pugi::xml_node& include, int depth) {
+        const XmlSource& here = source_of(include);
+        const char* file = include.attribute("file").as_string(nullptr);
+        if (file == nullptr || *file == '\0') return here.error_at(include, "<include> without a file attribute");
+        if (depth >= max_include_depth) return here.error_at(include, "includes nested too deeply (a cycle?)");
+        std::filesystem::path included = file;
+        if (included.is_relative()) included = base_directory_ / included;
+        // The name comes from the file, so it may be /dev/zero, /dev/stdin or a FIFO, which would never end.
+        std::error_code ignored;
+        if (std::filesystem::exists(included, ignored) && !std::filesystem::is_regular_file(included, ignored))
+            return here.error_at(include, "cannot include '" + std::string(file) + "': not a regular file");
+        const std::string key = file_key(included);
+        if (const auto seen = included_files_.find(key); seen != included_files_.end())
+            return here.error_at(include, "'" + std::string(file) + "' is included a second time (first " +
+                                              seen->second + "); MuJoCo includes a file once");
+        Result<std::unique_ptr<XmlSource>> loaded = XmlSource::load(included.string());
+        if (!loaded) {
+            // Report where the include is, and why the included file failed.
+            return here.error_at(include, "cannot include '" + std::string(file) + "': " + loaded.error().to_string());
+        }
+        included_files_[key] = "at " + here.path() + ":" + std::to_string(here.line_of(include));
+        sources_.push_back(std::move(loaded.value()));
+        expanded_[include.internal_object()] = sources_.back().get();
+        return sources_.back().get();
+    }
+
+    // The same key for every name of one file (relative, with .., through links), where it can be resolved.
+    static std::string file_key(const std::filesystem::path& path) {
+        std::error_code error;
+        const std::filesystem::path resolved = std::filesystem::weakly_canonical(path, error);
+        return (error ? path.lexically_normal() : resolved).string();
     }
 
     // The file a node was parsed from (the main file or one of the includes).
@@ -157,11 +188,19 @@ private:
     Status read_default(const pugi::xml_node& element, const std::string& parent, int depth = 0) {
         const bool top_level = parent.empty();
         if (depth > max_tree_depth) return error_at(element, "<default> classes nested too deeply");
-        std::string name = element.attribute("class").as_string(top_level ? "main" : "");
+        std::string name = top_level ? "main" : element.attribute("class").as_string("");
         if (name.empty()) return error_at(element, "nested <default> without a class attribute");
         if (classes_.contains(name) && !top_level)
             return error_at(element, "default class '" + name + "' is defined twice");
         classes_[name].parent = parent;
+        // The top-level <default> is the root class whatever its class attribute says (MuJoCo applies it to every
+        // geom without a class); a name it gives is one more way to refer to it: a class of its own with no
+        // defaults, below main.
+        if (const std::string alias = element.attribute("class").as_string("main"); top_level && alias != "main") {
+            if (classes_.contains(alias) && classes_[alias].parent != "main")
+                return error_at(element, "default class '" + alias + "' is defined twice");
+            classes_[alias].parent = "main";
+        }
         return for_each_child(element, [&](pugi::xml_node child) -> Status {
             const std::string_view child_name = child.name();
             if (child_name == "default") return read_default(child, name, depth + 1);
@@ -269,8 +308,22 @@ private:
         return Mat3(Mat3::Identity());
     }
 
+    // Warns of each attribute of `element` that `known` does not list: MuJoCo refuses them, and a misspelt
+    // `eular` or `poss` would otherwise leave the element unturned or at the origin without a word.
+    void warn_unknown_attributes(const pugi::xml_node& element, std::span<const std::string_view> known) {
+        for (const pugi::xml_attribute& attribute : element.attributes())
+            if (std::find(known.begin(), known.end(), std::string_view(attribute.name())) == known.end())
+                warn(element, "unknown attribute '" + std::string(attribute.name()) + "' of <" +
+                                  std::string(element.name()) + "> ignored");
+    }
+
     // The local frame of a body or frame element: its own pos and orientation (bodies take no defaults).
     Result<RigidTransform> own_frame(const pugi::xml_node& element) {
+        // Every attribute of <body> and <frame> in MuJoCo 2.2-3.x.
+        static constexpr std::array<std::string_view, 14> known{
+            "name", "childclass", "pos", "quat", "axisangle", "xyaxes", "zaxis", "euler", "mocap", "gravcomp", "user",
+            "sleep", "class", "frame"};
+        warn_unknown_attributes(element, known);
         RigidTransform frame;
         if (const pugi::xml_attribute pos = element.attribute("pos")) {
             Result<std::vector<double>> p = numbers({pos.value(), element}, "pos", 3);
@@ -334,7 +387,14 @@ private:
                 }
                 if (name == "composite" || name == "flexcomp" || name == "replicate" || name == "attach") {
                     warn(child, "<" + std::string(name) + "> skipped: generated geometry is not supported");
+                    return Ok{};
                 }
+                // MuJoCo refuses an element its schema does not know; a misspelt <bdoy> would lose its geoms here
+                // without a word.
+                static constexpr std::array<std::string_view, 7> without_geometry{
+                    "inertial", "joint", "freejoint", "site", "camera", "light", "plugin"};
+                if (std::find(without_geometry.begin(), without_geometry.end(), name) == without_geometry.end())
+                    warn(child, "unknown element <" + std::string(name) + "> in a body skipped, with whatever it holds");
                 return Ok{};
             });
         };
@@ -354,24 +414,35 @@ private:
         if (!chain_result) return chain_result.error();
         const std::vector<const DefaultClass*>& chain = *chain_result;
         const std::string name = geom.attribute("name").as_string(fallback_name.c_str());
+        // Every attribute of <geom> in MuJoCo 2.2-3.x.
+        static constexpr std::array<std::string_view, 34> known{
+            "name",     "class",    "type",        "contype",   "conaffinity", "condim",     "group",
+            "priority", "size",     "material",    "friction",  "mass",        "density",    "shellinertia",
+            "solmix",   "solref",   "solimp",      "margin",    "gap",         "fromto",     "pos",
+            "quat",     "axisangle", "xyaxes",     "zaxis",     "euler",       "hfield",     "mesh",
+            "fitscale", "rgba",     "fluidshape",  "fluidcoef", "user",        "plugin"};
+        warn_unknown_attributes(geom, known);
 
         // Stage 1: is this collision geometry at all?
         const FoundAttribute type_attribute = find_attribute(geom, chain, "type");
         const std::string type = type_attribute.value != nullptr ? type_attribute.value : "sphere";
         if (type == "plane" || type == "hfield") return Ok{};  // Floors and terrain are not object primitives.
+        // A collision bit mask: one whole number, blanks around it and a decimal point allowed ("1 ", "1.0"),
+        // as MuJoCo 2.2.2 reads it.
+        bool collides = false;
         for (const char* flag : {"contype", "conaffinity"}) {
             const FoundAttribute found = find_attribute(geom, chain, flag);
-            if (found.value == nullptr) continue;
-            char* end = nullptr;
-            std::strtol(found.value, &end, 10);
-            if (end == found.value || *end != '\0')
+            if (found.value == nullptr) {
+                collides = true;  // both default to 1
+                continue;
+            }
+            const std::optional<std::vector<double>> value = detail::parse_numbers(found.value);
+            if (!value || value->size() != 1 || std::trunc(value->front()) != value->front() ||
+                std::abs(value->front()) > 2147483647.0)
                 return error_at(found.element, std::string(flag) + "=\"" + found.value + "\" is not an integer");
+            collides = collides || value->front() != 0.0;
         }
-        const auto flag_value = [&](const char* flag) {
-            const FoundAttribute found = find_attribute(geom, chain, flag);
-            return found.value == nullptr ? 1L : std::strtol(found.value, nullptr, 10);
-        };
-        if (flag_value("contype") == 0 && flag_value("conaffinity") == 0) return Ok{};
+        if (!collides) return Ok{};
         if (type == "mesh" || type == "sdf") {
             warn(geom, type + " geom '" + name + "' skipped: the MJCF importer reads primitives only");
             return Ok{};
@@ -409,7 +480,9 @@ private:
             if (!ends) return ends.error();
             const Vec3 from((*ends)[0], (*ends)[1], (*ends)[2]);
             const Vec3 to((*ends)[3], (*ends)[4], (*ends)[5]);
-            std::optional<Mat3> rotation = detail::rotation_from_z_axis(to - from);
+            // MuJoCo turns z onto from - to (checked against mj_forward of 2.2.2): a box's or ellipsoid's x and y
+            // axes depend on that sign unless the segment lies on a world axis.
+            std::optional<Mat3> rotation = detail::rotation_from_z_axis(from - to);
             if (!rotation) return error_at(fromto.element, "fromto end points coincide");
             local.rotation = *rotation;
             local.translation = 0.5 * (from + to);
@@ -461,6 +534,8 @@ private:
     std::string main_path_;
     std::filesystem::path base_directory_;
     std::vector<std::unique_ptr<XmlSource>> sources_;
+    std::map<pugi::xml_node_struct*, const XmlSource*> expanded_;  ///< Each <include> read, and its file.
+    std::map<std::string, std::string> included_files_;          ///< file_key of each file read -> where: "at file:line" of its <include>, or "as the main file"
     std::map<std::string, DefaultClass> classes_;
     CompilerSettings compiler_;
     ImportResult result_;

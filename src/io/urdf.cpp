@@ -169,8 +169,15 @@ public:
                                          "link '" + link_name + "' is its own ancestor: its joints form a cycle");
             const RigidTransform& world_from_link = *frame;
             const std::vector<CollisionSite>& sites = collisions_[link_name];
-            if (sites.size() != link->collision_array.size())
-                return source_->error_at(link_element, "urdfdom read a different number of collisions");
+            if (sites.size() != link->collision_array.size()) {
+                // urdfdom drops what it cannot parse (a <mesh> without a filename, a scale that is no numbers, and
+                // with them the rest of the link) and says why on its console, captured above: pass that on.
+                std::string message = "urdfdom read " + std::to_string(link->collision_array.size()) + " of the " +
+                                      std::to_string(sites.size()) + " collisions of link '" + link_name + "'";
+                for (std::size_t i = 0; i < output.messages.size(); ++i)
+                    message += (i == 0 ? ": " : "; ") + output.messages[i];
+                return source_->error_at(link_element, message);
+            }
             for (std::size_t i = 0; i < sites.size(); ++i) {
                 const std::string fallback = link_name + "_collision" + std::to_string(i);
                 const std::size_t before = result_.primitives.size();
@@ -248,7 +255,9 @@ private:
                 for (const NumberRule& rule : rules)
                     if (Status checked = check_numbers(*source_, shape_element, patched_shape, rule); !checked)
                         return checked;
-                if (const pugi::xml_node capsule = collision.child("geometry").child("capsule")) {
+                // The first shape only: a <capsule> after another shape is ignored with it (it replaced the first).
+                if (shape_name == "capsule") {
+                    const pugi::xml_node capsule = shape_element;
                     CapsuleShape shape;
                     for (auto [attribute, slot] : {std::pair{"radius", &shape.radius}, {"length", &shape.length}}) {
                         std::optional<std::vector<double>> value = detail::parse_numbers(capsule.attribute(attribute).value());

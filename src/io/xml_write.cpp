@@ -14,6 +14,7 @@
 
 #include "hbvh/assert.hpp"
 #include "../memory/huge_pages.hpp"
+#include "../tree/utf8.hpp"
 #include "xml_number.hpp"
 
 namespace hbvh {
@@ -79,7 +80,12 @@ void append_volume(Out& out, const BoundingVolume& bv, std::string_view name, st
     out += '"';
     if (!name.empty()) {
         out += " name=\"";
-        append_escaped(out, name);
+        // The declaration promises UTF-8: a name that is none (from a Latin-1 asset) is written repaired.
+        std::size_t bad_at = 0;
+        if (detail::utf8_problem(name, bad_at).empty())
+            append_escaped(out, name);
+        else
+            append_escaped(out, detail::utf8_name(name));
         out += '"';
     }
     std::visit(Overloaded{

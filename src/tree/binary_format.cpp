@@ -24,6 +24,7 @@
 #include "../memory/huge_pages.hpp"
 #include "binary_decoding.hpp"
 #include "little_endian.hpp"
+#include "utf8.hpp"
 
 namespace hbvh {
 namespace {
@@ -220,43 +221,6 @@ private:
     std::size_t at_ = 0;
 };
 
-/// Empty when `text` is well-formed UTF-8 (no overlong forms, no surrogates, nothing above U+10FFFF) without
-/// NUL; else the problem and, in `bad_at`, the offset of the offending byte within `text`.
-std::string utf8_problem(std::string_view text, std::size_t& bad_at) {
-    const auto* s = reinterpret_cast<const unsigned char*>(text.data());
-    const std::size_t n = text.size();
-    for (std::size_t i = 0; i < n;) {
-        bad_at = i;
-        const unsigned char c = s[i];
-        if (c == 0) return "a name holds a NUL byte";
-        if (c < 0x80) {
-            ++i;
-            continue;
-        }
-        std::size_t length = 0;
-        std::uint32_t code = 0, smallest = 0;
-        if ((c & 0xE0) == 0xC0) length = 2, code = c & 0x1F, smallest = 0x80;
-        else if ((c & 0xF0) == 0xE0) length = 3, code = c & 0x0F, smallest = 0x800;
-        else if ((c & 0xF8) == 0xF0) length = 4, code = c & 0x07, smallest = 0x10000;
-        else return "a name is not UTF-8 (byte 0x" + [&] {
-            char hex[3];
-            std::to_chars(hex, hex + 2, c, 16);
-            hex[2] = 0;
-            return std::string(hex);
-        }() + " cannot start a character)";
-        if (length > n - i) return "a name is not UTF-8 (a character is cut off at its end)";
-        for (std::size_t k = 1; k < length; ++k) {
-            if ((s[i + k] & 0xC0) != 0x80) return "a name is not UTF-8 (a character's continuation byte is missing)";
-            code = (code << 6) | (s[i + k] & 0x3F);
-        }
-        if (code < smallest) return "a name is not UTF-8 (overlong encoding)";
-        if (code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF))
-            return "a name is not UTF-8 (no Unicode character: surrogate or above U+10FFFF)";
-        i += length;
-    }
-    return {};
-}
-
 /// The index K of a check's message that starts "<word> K", or -1.
 long long leading_index(const std::string& message, std::string_view word) {
     if (message.size() <= word.size() + 1 || message.compare(0, word.size(), word) != 0 || message[word.size()] != ' ')
@@ -392,7 +356,7 @@ DecodeOutcome decode_primitive_records(const unsigned char* data, std::size_t en
         const std::string_view name = reader.bytes(length);
         std::size_t bad_at = 0;
         if (!is_plain_ascii(name))
-            if (std::string bad = utf8_problem(name, bad_at); !bad.empty()) return fail(name_at + bad_at, bad);
+            if (std::string bad = detail::utf8_problem(name, bad_at); !bad.empty()) return fail(name_at + bad_at, bad);
         if (primitives != nullptr) (*primitives)[i].name.assign(name);
     }
     if (reader.left() != 0)
@@ -426,9 +390,23 @@ bool has_binary_magic(std::span<const std::byte> bytes) {
 
 std::string write_binary(const Bvh& bvh) {
     // Stage 1: the exact size, so that the buffer is allocated once.
+    // A name that is no UTF-8 (or holds a NUL) is written repaired, as the reader accepts only UTF-8 (utf8_name):
+    // such a file could not be read back.
+    std::vector<std::string> repaired_names;
+    std::vector<std::uint32_t> repaired_at;
+    for (std::uint32_t i = 0; i < bvh.primitives.size(); ++i) {
+        std::size_t bad_at = 0;
+        if (const std::string& name = bvh.primitives[i].name;
+            !is_plain_ascii(name) && !detail::utf8_problem(name, bad_at).empty()) {
+            repaired_names.push_back(detail::utf8_name(name));
+            repaired_at.push_back(i);
+        }
+    }
     std::size_t size = binary_header_size + binary_checksum_size;
     for (const Node& node : bvh.nodes) size += volume_record_size(node.volume) + binary_node_links_size;
     for (const Primitive& primitive : bvh.primitives) size += volume_record_size(primitive.volume) + 4 + primitive.name.size();
+    for (std::size_t k = 0; k < repaired_at.size(); ++k)
+        size = size - bvh.primitives[repaired_at[k]].name.size() + repaired_names[k].size();
     std::string out;
     detail::resize_on_huge_pages(out, size);
     auto* data = reinterpret_cast<unsigned char*>(out.data());
@@ -448,9 +426,12 @@ std::string write_binary(const Bvh& bvh) {
         writer.u32(node.primitive);
     }
     for (const Primitive& primitive : bvh.primitives) writer.volume(primitive.volume);
-    for (const Primitive& primitive : bvh.primitives) {
-        writer.u32(static_cast<std::uint32_t>(primitive.name.size()));
-        writer.bytes(primitive.name);
+    std::size_t next_repaired = 0;
+    for (std::uint32_t i = 0; i < bvh.primitives.size(); ++i) {
+        const bool repaired = next_repaired < repaired_at.size() && repaired_at[next_repaired] == i;
+        const std::string& name = repaired ? repaired_names[next_repaired++] : bvh.primitives[i].name;
+        writer.u32(static_cast<std::uint32_t>(name.size()));
+        writer.bytes(name);
     }
 
     // Stage 3: the checksum over everything before it.

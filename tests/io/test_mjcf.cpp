@@ -151,7 +151,8 @@ bool write_oracle_copy(const fs::path& source, const fs::path& main_folder, cons
 // Include fragments are left out, and so are byte-identical copies (three shared models are Debian samples).
 std::vector<fs::path> oracle_candidates() {
     std::vector<fs::path> files;
-    for (const char* name : {"mjcf_defaults.xml", "mjcf_orientations.xml", "mjcf_fromto.xml", "mjcf_include_main.xml"})
+    for (const char* name : {"mjcf_defaults.xml", "mjcf_orientations.xml", "mjcf_fromto.xml", "mjcf_include_main.xml",
+                             "mjcf_named_root_default.xml"})
         files.push_back(test::test_data_dir() / name);
     std::vector<fs::path> found;
     for (const fs::path& folder : {fs::path("/usr/share/mujoco/model"), test::shared_models_dir()}) {
@@ -443,7 +444,50 @@ TEST(Mjcf, IncludeCycleIsAnError) {
     std::ofstream(folder.path / "b.xml") << "<mujoco><include file=\"a.xml\"/></mujoco>";
     const Result<ImportResult> imported = import_mjcf((folder.path / "a.xml").string());
     ASSERT_FALSE(imported.has_value());
-    EXPECT_NE(imported.error().message.find("nested too deeply"), std::string::npos) << imported.error().to_string();
+    EXPECT_NE(imported.error().message.find("included a second time"), std::string::npos) << imported.error().to_string();
+}
+
+TEST(Mjcf, MisspeltElementsAndAttributesAreWarnedOf) {
+    // MuJoCo refuses what its schema does not know; the importer reads on, but says what it skipped (a misspelt
+    // <bdoy> lost its geoms, `eular` left a body unturned, without a word).
+    TempDir folder;
+    std::ofstream(folder.path / "typo.xml")
+        << "<mujoco><worldbody>\n<bdoy pos=\"5 0 0\"><geom size=\"2\"/></bdoy>\n"
+           "<body eular=\"0 0 90\" pos=\"1 0 0\">\n<geom type=\"box\" size=\"1 1 1\" poss=\"1 0 0\"/>\n"
+           "<joint/><inertial pos=\"0 0 0\" mass=\"1\"/><site/></body>\n</worldbody></mujoco>";
+    const Result<ImportResult> imported = import_mjcf((folder.path / "typo.xml").string());
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    EXPECT_EQ(imported->primitives.size(), 1u);
+    ASSERT_EQ(imported->warnings.size(), 3u);
+    EXPECT_NE(imported->warnings[0].find("typo.xml:2: unknown element <bdoy> in a body skipped"), std::string::npos)
+        << imported->warnings[0];
+    EXPECT_NE(imported->warnings[1].find("typo.xml:3: unknown attribute 'eular' of <body> ignored"), std::string::npos)
+        << imported->warnings[1];
+    EXPECT_NE(imported->warnings[2].find("typo.xml:4: unknown attribute 'poss' of <geom> ignored"), std::string::npos)
+        << imported->warnings[2];
+}
+
+TEST(Mjcf, AFileIsIncludedOnceAsInMuJoCo) {
+    // 17 small files, each including the next one twice: expanded every time, the 2^16 copies took minutes and
+    // gigabytes. MuJoCo refuses the second include of a file; so does the importer, at once, naming both places.
+    TempDir folder;
+    for (int i = 0; i < 16; ++i)
+        std::ofstream(folder.path / ("L" + std::to_string(i) + ".xml"))
+            << "<mujoco>\n<include file=\"L" << i + 1 << ".xml\"/>\n<include file=\"L" << i + 1 << ".xml\"/>\n</mujoco>";
+    std::ofstream(folder.path / "L16.xml") << "<mujoco><worldbody><geom size=\"1\"/></worldbody></mujoco>";
+    const Result<ImportResult> imported = import_mjcf((folder.path / "L0.xml").string());
+    ASSERT_FALSE(imported.has_value());
+    // Depth first: the first file read twice is the last one, from L15.xml's second line of includes.
+    EXPECT_EQ(fs::path(imported.error().file).filename(), "L15.xml");
+    EXPECT_EQ(imported.error().line, 3);
+    EXPECT_NE(imported.error().message.find("'L16.xml' is included a second time (first at "), std::string::npos)
+        << imported.error().to_string();
+    // Once is fine, from the defaults' pass and the bodies' pass alike.
+    std::ofstream(folder.path / "once.xml")
+        << "<mujoco><include file=\"L16.xml\"/><worldbody><geom size=\"2\"/></worldbody></mujoco>";
+    const Result<ImportResult> once = import_mjcf((folder.path / "once.xml").string());
+    ASSERT_TRUE(once.has_value()) << once.error().to_string();
+    EXPECT_EQ(once->primitives.size(), 2u);
 }
 
 }  // namespace

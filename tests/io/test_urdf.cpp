@@ -107,6 +107,13 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
          "</geometry></collision></link>\n</robot>",
          3, "<cylinder> attribute 'radius' must not be negative"},
         {"<robot name=\"r\">\n<link>\n</link>\n</robot>", 2, "<link> without a name"},
+        // What urdfdom drops, with its own reason (the message blamed "a different number of collisions").
+        {"<robot name=\"r\">\n<link name=\"a\">\n<collision><geometry><sphere radius=\"1\"/></geometry></collision>"
+         "<collision><geometry><mesh/></geometry></collision></link>\n</robot>",
+         2, "urdfdom read 1 of the 2 collisions of link 'a': Mesh must contain a filename attribute"},
+        {"<robot name=\"r\">\n<link name=\"a\">\n<inertial><mass value=\"-abc\"/></inertial>"
+         "<collision><geometry><sphere radius=\"1\"/></geometry></collision></link>\n</robot>",
+         2, "mass [-abc] is not a float"},
         {"<robot name=\"r\">\n<link name=\"a\"/>\n<link name=\"b\"/>\n<joint name=\"j\" type=\"fixed\">\n"
          "<parent link=\"a\"/><child link=\"b\"/>\n<origin xyz=\"0 0\"/></joint>\n</robot>",
          6, "<origin> attribute 'xyz' needs 3 finite numbers, found \"0 0\""},
@@ -131,6 +138,17 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
     ASSERT_EQ(imported->warnings.size(), 1u);
     EXPECT_NE(imported->warnings[0].find("cone.urdf:3: collision with unknown geometry <cone>"), std::string::npos)
         << imported->warnings[0];
+    // Two shapes in one <geometry>: the first is read, as the warning says, even when a <capsule> follows (it
+    // replaced the box).
+    const fs::path two_shapes = folder / "two_shapes.urdf";
+    std::ofstream(two_shapes) << "<robot name=\"r\">\n<link name=\"a\">\n<collision><geometry><box size=\"1 1 1\"/>"
+                                 "<capsule radius=\"0.1\" length=\"0.5\"/></geometry></collision></link>\n</robot>";
+    const Result<ImportResult> first_shape = import_urdf(two_shapes.string());
+    ASSERT_TRUE(first_shape.has_value()) << first_shape.error().to_string();
+    ASSERT_EQ(first_shape->primitives.size(), 1u);
+    EXPECT_TRUE(std::holds_alternative<Obb>(first_shape->primitives[0].volume));
+    ASSERT_EQ(first_shape->warnings.size(), 1u);
+    EXPECT_NE(first_shape->warnings[0].find("only the first, <box>"), std::string::npos) << first_shape->warnings[0];
     // Blanks around a number, which urdfdom refuses, are read: the number is handed on in a form it takes.
     const fs::path padded = folder / "padded.urdf";
     std::ofstream(padded) << "<robot name=\"r\">\n<link name=\"a\"><collision><origin xyz=\" 1 2 3 \"/><geometry>"

@@ -151,6 +151,17 @@ TEST(Xml, PrimitiveSetRoundTrip) {
     }
 }
 
+// The declaration says UTF-8, so a name that is none (a Latin-1 byte from an old asset) is written with U+FFFD
+// for each bad byte, as JSON, glTF and HTML do: written as it was, no XML parser but pugixml read the file back.
+TEST(Xml, NamesThatAreNoUtf8AreWrittenRepaired) {
+    std::vector<Primitive> primitives{{Sphere{Vec3(0, 0, 0), 1.0}, "caf\xe9 & \xff"}, {Sphere{Vec3(3, 0, 0), 1.0}, "ok"}};
+    const std::string text = write_primitives_xml(primitives);
+    EXPECT_NE(text.find("name=\"caf\xef\xbf\xbd &amp; \xef\xbf\xbd\""), std::string::npos) << text;
+    const XmlModel model = read_ok(text);
+    EXPECT_EQ(model.primitives[0].name, "caf\xef\xbf\xbd & \xef\xbf\xbd");
+    EXPECT_EQ(model.primitives[1].name, "ok");
+}
+
 // OBBs and spheres come back from hbvh's own XML bit for bit, so rewriting a file hbvh wrote gives the same text
 // (every OBB's matrix was replaced by its polar factor on each read, which moved last bits on every pass). A
 // matrix rounded by hand is still replaced by the nearest rotation.

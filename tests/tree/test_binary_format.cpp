@@ -216,16 +216,38 @@ TEST(BinaryFormat, SingleLeafAndPrimitiveSetRoundTrip) {
 }
 
 TEST(BinaryFormat, NamesMustBeUtf8WithoutNul) {
-    for (const std::string& bad : {std::string("\xff"), std::string("ab\xc3"), std::string("\xc0\x80"),
-                                  std::string("\xed\xa0\x80"), std::string("a\0b", 3), std::string("\xf4\x90\x80\x80")}) {
+    // The reader refuses such names (written here behind a good checksum: a placeholder of the same length,
+    // replaced in the bytes, then resealed)...
+    const std::vector<std::string> bad_names{std::string("\xff"),         std::string("ab\xc3"),
+                                             std::string("\xc0\x80"),     std::string("\xed\xa0\x80"),
+                                             std::string("a\0b", 3),      std::string("\xf4\x90\x80\x80")};
+    for (const std::string& bad : bad_names) {
         Bvh set;
-        set.primitives.push_back({Sphere{Vec3(0, 0, 0), 1.0}, bad});
-        Result<Bvh> back = read(write_binary(set));
+        set.primitives.push_back({Sphere{Vec3(0, 0, 0), 1.0}, std::string(bad.size(), 'x')});
+        std::string bytes = write_binary(set);
+        const std::size_t at = bytes.size() - 8 - bad.size();  // the last name, then the 8-byte checksum
+        ASSERT_EQ(bytes.substr(at, bad.size()), std::string(bad.size(), 'x'));
+        bytes.replace(at, bad.size(), bad);
+        reseal(bytes);
+        Result<Bvh> back = read(bytes);
         ASSERT_FALSE(back.has_value()) << "accepted a bad name";
         EXPECT_TRUE(back.error().message.find("NUL") != std::string::npos ||
                     back.error().message.find("not UTF-8") != std::string::npos)
             << back.error().message;
     }
+    // ... and the writer never makes one: each byte that starts no character becomes U+FFFD, a NUL ends the name
+    // (a Latin-1 name from an old asset was written as it was, and the file could not be read back).
+    const std::vector<std::pair<std::string, std::string>> repaired{
+        {"caf\xe9", "caf\xef\xbf\xbd"},
+        {"ab\xc3", "ab\xef\xbf\xbd"},
+        {"\xc0\x80z", "\xef\xbf\xbd\xef\xbf\xbdz"},
+        {std::string("a\0b", 3), "a"},
+        {"ok \xc3\xa9", "ok \xc3\xa9"}};
+    Bvh set;
+    for (const auto& [name, expected] : repaired) set.primitives.push_back({Sphere{Vec3(0, 0, 0), 1.0}, name});
+    const Result<Bvh> back = read(write_binary(set));
+    ASSERT_TRUE(back.has_value()) << back.error().to_string();
+    for (std::size_t i = 0; i < repaired.size(); ++i) EXPECT_EQ(back->primitives[i].name, repaired[i].second) << i;
 }
 
 TEST(BinaryFormat, EveryTruncationIsRefused) {
