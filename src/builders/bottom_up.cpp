@@ -92,6 +92,8 @@ const FittedGroup& Level::fit_group(std::span<const std::uint32_t> members) cons
     HBVH_ASSERT(!members.empty());
     std::vector<std::uint32_t> key(members.begin(), members.end());
     if (auto found = fitted_.find(key); found != fitted_.end()) return found->second;
+    if (deadline_ != std::chrono::steady_clock::time_point::max() && std::chrono::steady_clock::now() >= deadline_)
+        throw LevelDeadlinePassed{};
     // Fit around the primitives themselves (Definition 1.2: a BV need only cover coverage(n)), in member
     // order and each node's canonical primitive order, so the fitters always see the same sphere sequence.
     FitInput input;
@@ -174,6 +176,53 @@ std::vector<std::vector<std::uint32_t>> fallback_member_sets(const Level& level)
     return sets;
 }
 
+namespace {
+
+/// Lines 1.4-1.5 of the survey's level step: the heuristic's candidates (left in `candidates`) and the solver,
+/// with the fall-backs where they find no exact cover. Returns the chosen groups (member indices of `level`).
+std::vector<std::vector<std::uint32_t>> choose_groups(const Level& level, const CandidateGenerator& generate,
+                                                      const LevelSolver& solve, const BottomUpOptions& options,
+                                                      std::uint32_t level_index, std::vector<Candidate>& candidates,
+                                                      LevelReport& row) {
+    const std::uint32_t n = level.size();
+    // Stage 1: the heuristic's candidates and the solver.
+    candidates = make_candidates(level, generate(level));
+    std::vector<double> volumes(n);
+    for (std::uint32_t j = 0; j < n; ++j) volumes[j] = level.nodes()[j].weighted_volume;
+    std::optional<Partition> partition = solve(n, candidates, volumes, options.budget);
+    auto account = [&](const std::optional<Partition>& result) {
+        if (!result) return;
+        row.solver_nodes += result->nodes_explored;
+        row.budget_hit = row.budget_hit || result->budget_hit;
+    };
+    account(partition);
+    std::string note;
+
+    // Stage 2: no exact cover (the survey's failure case, end of §3) -> add each node's best pair
+    // and triple and solve again.
+    if (!partition) {
+        row.fallback_used = true;
+        std::vector<std::vector<std::uint32_t>> sets = fallback_member_sets(level);
+        for (Candidate& c : candidates) sets.push_back(std::move(c.members));
+        candidates = make_candidates(level, std::move(sets));
+        partition = solve(n, candidates, volumes, options.budget);
+        account(partition);
+        note = "level " + std::to_string(level_index) + ": no exact cover among the candidates; added pair/triple candidates";
+    }
+    std::vector<std::vector<std::uint32_t>> groups;
+    if (partition) {
+        for (std::uint32_t c : partition->chosen) groups.push_back(candidates[c].members);
+    } else {
+        // Stage 3: still none (or the budget ran out first): a greedy cover that cannot fail.
+        groups = greedy_cover(level, candidates);
+        note += "; still none, used the greedy cover";
+    }
+    if (!note.empty() && options.report) options.report->notes.push_back(std::move(note));
+    return groups;
+}
+
+}  // namespace
+
 Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& policy, const CandidateGenerator& generate,
                     const LevelSolver& solve, const BottomUpOptions& options) {
     HBVH_ASSERT(!primitives.empty());
@@ -190,58 +239,37 @@ Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& p
 
     std::uint32_t level_index = 0;
     const double primitive_count = static_cast<double>(primitives.size());
+    // Anytime: once the deadline has passed, the levels built so far stay and one root takes the rest.
+    const auto root_over_the_rest = [&](std::span<const LevelNode> left) {
+        FitInput input;
+        for (const LevelNode& node : left)
+            for (std::uint32_t p : node.primitives) input.add(primitives[p].volume);
+        const std::uint32_t root = assembler.add_group(ids, fit_best(input.spheres, policy, input.hint_axes));
+        options.checkpoint->context().note_deadline("time limit reached after " + std::to_string(level_index) +
+                                                    " levels; one root over the " + std::to_string(left.size()) +
+                                                    " nodes left");
+        return std::move(assembler).finish(root);
+    };
     while (nodes.size() > 1) {
-        // Anytime: once the deadline has passed, the levels built so far stay and one root takes the rest.
-        if (options.checkpoint != nullptr && options.checkpoint->context().expired()) {
-            FitInput input;
-            for (const LevelNode& node : nodes)
-                for (std::uint32_t p : node.primitives) input.add(primitives[p].volume);
-            const std::uint32_t root = assembler.add_group(ids, fit_best(input.spheres, policy, input.hint_axes));
-            options.checkpoint->context().note_deadline(
-                "time limit reached after " + std::to_string(level_index) + " levels; one root over the " +
-                std::to_string(nodes.size()) + " nodes left");
-            return std::move(assembler).finish(root);
-        }
+        if (options.checkpoint != nullptr && options.checkpoint->context().expired()) return root_over_the_rest(nodes);
         if (options.checkpoint != nullptr) options.checkpoint->report(primitive_count - static_cast<double>(nodes.size()));
         const auto start = std::chrono::steady_clock::now();
-        const Level level(primitives, std::move(nodes), policy);
+        Level level(primitives, std::move(nodes), policy);
         const std::uint32_t n = level.size();
         LevelReport row;
         row.nodes = n;
-
-        // Stage 1: the heuristic's candidates and the solver (lines 1.4-1.5).
-        std::vector<Candidate> candidates = make_candidates(level, generate(level));
-        std::vector<double> volumes(n);
-        for (std::uint32_t j = 0; j < n; ++j) volumes[j] = level.nodes()[j].weighted_volume;
-        std::optional<Partition> partition = solve(n, candidates, volumes, options.budget);
-        auto account = [&](const std::optional<Partition>& result) {
-            if (!result) return;
-            row.solver_nodes += result->nodes_explored;
-            row.budget_hit = row.budget_hit || result->budget_hit;
-        };
-        account(partition);
-        std::string note;
-
-        // Stage 2: no exact cover (the survey's failure case, end of §3) -> add each node's best pair
-        // and triple and solve again.
-        if (!partition) {
-            row.fallback_used = true;
-            std::vector<std::vector<std::uint32_t>> sets = fallback_member_sets(level);
-            for (Candidate& c : candidates) sets.push_back(std::move(c.members));
-            candidates = make_candidates(level, std::move(sets));
-            partition = solve(n, candidates, volumes, options.budget);
-            account(partition);
-            note = "level " + std::to_string(level_index) + ": no exact cover among the candidates; added pair/triple candidates";
-        }
+        // The candidates, the solver and the fall-backs fit new groups until the partition is chosen; past the
+        // deadline the next such fit ends the level (the heuristics alone took minutes at 900 nodes).
+        if (options.checkpoint != nullptr) level.stop_fitting_after(options.checkpoint->context().deadline);
+        std::vector<Candidate> candidates;
         std::vector<std::vector<std::uint32_t>> groups;
-        if (partition) {
-            for (std::uint32_t c : partition->chosen) groups.push_back(candidates[c].members);
-        } else {
-            // Stage 3: still none (or the budget ran out first): a greedy cover that cannot fail.
-            groups = greedy_cover(level, candidates);
-            note += "; still none, used the greedy cover";
+        try {
+            groups = choose_groups(level, generate, solve, options, level_index, candidates, row);
+        } catch (const LevelDeadlinePassed&) {
+            return root_over_the_rest(level.nodes());
         }
-        if (!note.empty() && options.report) options.report->notes.push_back(std::move(note));
+        level.stop_fitting_after(std::chrono::steady_clock::time_point::max());
+
 
         // Each chosen group becomes a node of the next level, with the BV already fitted for its cost.
         std::vector<LevelNode> next;

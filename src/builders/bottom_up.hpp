@@ -3,6 +3,7 @@
 // and the set-partition solver plugged in, so that better heuristics and solvers reuse the same loop.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <functional>
 #include <map>
@@ -59,6 +60,10 @@ public:
     [[nodiscard]] double tightness(std::span<const std::uint32_t> members) const;
     /// Number of distinct groups fitted so far.
     [[nodiscard]] std::size_t fitted_count() const { return fitted_.size(); }
+    /// From now on, a fit_group that would fit a new group after `deadline` throws LevelDeadlinePassed instead:
+    /// the survey's candidate heuristics fit O(n^2) groups a level, minutes at 900 nodes, and the deadline is
+    /// otherwise seen only between levels. time_point::max(): never (the default).
+    void stop_fitting_after(std::chrono::steady_clock::time_point deadline) { deadline_ = deadline; }
 
 private:
     std::span<const Primitive> primitives_;
@@ -66,7 +71,11 @@ private:
     VolumePolicy policy_;
     Aabb bounds_;
     mutable std::map<std::vector<std::uint32_t>, FittedGroup> fitted_;
+    std::chrono::steady_clock::time_point deadline_ = std::chrono::steady_clock::time_point::max();
 };
+
+/// Thrown by Level::fit_group past the deadline set by stop_fitting_after.
+struct LevelDeadlinePassed {};
 
 /// A candidate heuristic: member sets (node indices of `level`) to offer the solver. Sets may come in any
 /// order, unsorted or repeated; the driver normalises them, drops singletons and duplicates, and prices them.

@@ -3,6 +3,7 @@
 // fallbacks, and plugging in any generator and solver.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <optional>
 #include <vector>
 
@@ -113,6 +114,46 @@ TEST(BuildBottomUp, UsesThePluggedSolverAndReportsItsBudget) {
     EXPECT_TRUE(report.budget_hit);
     // 6 cubes in a row, pairs only: three pairs, then three nodes (fallback), then the root.
     EXPECT_EQ(report.levels.front().groups, 3u);
+}
+
+TEST(BuildBottomUp, ADeadlineThatPassesInsideALevelEndsItAtTheNextFit) {
+    // The survey's heuristics fit O(n^2) groups a level (bnb-tightest at 900 primitives took minutes past a
+    // --time-limit of 0.2 s), and the deadline was seen only between levels. This generator first waits until the
+    // deadline has passed, then fits as Tightest does: the first new fit ends the level, and the tree is one
+    // root over the level's nodes, with the note.
+    const std::vector<Primitive> primitives = row_of_cubes(12);
+    BuildReport report;
+    BuildContext context;
+    context.report = &report;
+    context.deadline = BuildContext::Clock::now() + std::chrono::milliseconds(20);
+    const detail::Checkpoint checkpoint(context, 12.0);
+    bool fitted_past_the_deadline = false;
+    const CandidateGenerator late = [&](const Level& level) {
+        while (!context.expired()) {
+        }
+        const std::vector<std::uint32_t> pair{0, 1};
+        (void)level.fit_group(pair);
+        fitted_past_the_deadline = true;
+        return std::vector<std::vector<std::uint32_t>>{pair};
+    };
+    const Bvh bvh = build_bottom_up(primitives, VolumePolicy::all(), late, reference_level_solver(),
+                                    {SolverBudget{}, &report, &checkpoint});
+    EXPECT_FALSE(fitted_past_the_deadline);
+    ASSERT_TRUE(validate(bvh).has_value());
+    EXPECT_EQ(bvh.nodes.front().child_count, 12u);
+    EXPECT_TRUE(report.budget_hit);
+    ASSERT_FALSE(report.notes.empty());
+    EXPECT_NE(report.notes.back().find("time limit reached after 0 levels; one root over the 12 nodes left"),
+              std::string::npos)
+        << report.notes.back();
+    // A fit the level already holds is no new work and is still answered.
+    const Level level = make_level(primitives, VolumePolicy::all());
+    const std::vector<std::uint32_t> pair{0, 1};
+    const FittedGroup& before = level.fit_group(pair);
+    Level late_level = make_level(primitives, VolumePolicy::all());
+    late_level.stop_fitting_after(BuildContext::Clock::now() - std::chrono::seconds(1));
+    EXPECT_THROW((void)late_level.fit_group(pair), LevelDeadlinePassed);
+    EXPECT_NEAR(before.weighted_volume, level.fit_group(pair).weighted_volume, 0.0);
 }
 
 TEST(BuildBottomUp, OnePrimitiveIsALoneLeaf) {
