@@ -20,7 +20,8 @@ struct BuildContext {
     /// finishes the tree the cheapest way it has (a flat group over what is left) and sets
     /// report->budget_hit. The default never passes.
     Clock::time_point deadline = Clock::time_point::max();
-    /// Called with the fraction done (0..1] between steps, from the calling thread. Empty: no calls. The
+    /// Called with the fraction done, in [0, 1] and never decreasing (0 as a build starts, 1 when it is done),
+    /// between steps, from the calling thread. Empty: no calls. The
     /// library never prints; the CLI draws the bar.
     std::function<void(double fraction)> progress;
     /// Filled when non-null: per-level rows, notes, lower bound, budget_hit.
