@@ -415,7 +415,7 @@ Bvh detail::refine_treelets_cached(const Bvh& bvh, const VolumePolicy& policy, c
     HBVH_ASSERT(cache.primitive_count() == bvh.primitives.size());
     const auto start = Clock::now();
     TreeletReport local;
-    if (bvh.nodes.size() < 2) {
+    if (bvh.nodes.size() < 2 || !validate_policy(policy)) {
         if (report != nullptr) *report = local;
         return bvh;
     }

@@ -50,6 +50,11 @@ BoundingVolume fit(BvType type, std::span<const Sphere> spheres, std::span<const
 
 BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& policy, std::span<const Mat3> hint_axes) {
     HBVH_ASSERT(!spheres.empty());
+    if (std::none_of(policy.allowed.begin(), policy.allowed.end(), [](bool allowed) { return allowed; })) {
+        VolumePolicy every_kind = policy;
+        every_kind.allowed.fill(true);
+        return fit_best(spheres, every_kind, hint_axes);
+    }
     if (spheres.size() > detail::repeats_checked_above) {
         const std::vector<Sphere> distinct = detail::without_repeats(spheres);
         if (!distinct.empty()) return fit_best(distinct, policy, hint_axes);

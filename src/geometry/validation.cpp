@@ -118,6 +118,10 @@ std::string volume_problem(const BoundingVolume& volume) {
 
 Status validate_primitives(std::span<const Primitive> primitives) {
     for (std::size_t i = 0; i < primitives.size(); ++i) {
+        // Both file formats end a name at a NUL (XML cannot hold one, the binary reader refuses it): such a name
+        // would come back cut short, so it is refused here rather than changed on saving.
+        if (primitives[i].name.find('\0') != std::string::npos)
+            return Error{"primitive " + std::to_string(i) + ": its name holds a NUL byte, which no hierarchy file keeps"};
         std::string problem = volume_problem(primitives[i].volume);
         if (problem.empty()) continue;
         std::string where = "primitive " + std::to_string(i);

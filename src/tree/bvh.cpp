@@ -27,10 +27,13 @@ std::vector<std::vector<std::uint32_t>> levels(const Bvh& bvh) {
 
 std::vector<std::uint32_t> covered_primitives(const Bvh& bvh, std::uint32_t index) {
     std::vector<std::uint32_t> out;
+    if (index >= bvh.nodes.size()) return out;  // no such node covers nothing (it read past the array)
     std::vector<std::uint32_t> stack{index};
     while (!stack.empty()) {
-        const Node& node = bvh.nodes[stack.back()];
+        const std::uint32_t at = stack.back();
         stack.pop_back();
+        if (at >= bvh.nodes.size()) continue;  // a malformed tree's child range (check_structure says which)
+        const Node& node = bvh.nodes[at];
         if (node.is_leaf()) out.push_back(node.primitive);
         for (std::uint32_t c = 0; c < node.child_count; ++c) stack.push_back(node.first_child + c);
     }

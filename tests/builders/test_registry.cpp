@@ -76,7 +76,9 @@ TEST(Registry, EveryBuilderReportsProgressUpToOne) {
             EXPECT_GE(fractions[i], 0.0) << row.name;
             EXPECT_LE(fractions[i], 1.0) << row.name;
             // A bar that runs backwards tells a user nothing: BuildContext::progress promises it never does.
-            if (i > 0) EXPECT_GE(fractions[i], fractions[i - 1]) << row.name << " at report " << i;
+            if (i > 0) {
+                EXPECT_GE(fractions[i], fractions[i - 1]) << row.name << " at report " << i;
+            }
         }
         EXPECT_EQ(fractions.back(), 1.0) << row.name;
     }

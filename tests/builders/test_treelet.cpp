@@ -90,6 +90,19 @@ TEST(Treelet, RespectsThePolicy) {
     }
 }
 
+TEST(Treelet, APolicyNoBuilderTakesLeavesTheTreeAsItIs) {
+    // No kind allowed: every refit was an empty box at the origin, enclosing nothing, at cost 0.
+    const std::vector<Primitive> primitives = generated_scene(12, 4);
+    const Result<Bvh> built = build(primitives, Algorithm::two_level);
+    ASSERT_TRUE(built.has_value());
+    VolumePolicy none = VolumePolicy::all();
+    none.allowed.fill(false);
+    const Bvh refined = refine_treelets(*built, none);
+    EXPECT_TRUE(validate(refined).has_value());
+    EXPECT_EQ(cost(refined), cost(*built));
+    EXPECT_EQ(refined.nodes.size(), built->nodes.size());
+}
+
 // With max_units >= n the root's treelet spans every primitive, so its DP is build_optimal's DP on the
 // same fits: the result is the optimum (an independent check of the refiner's bookkeeping).
 TEST(Treelet, OneTreeletOverEverythingIsOptimal) {

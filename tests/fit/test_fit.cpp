@@ -164,6 +164,17 @@ TEST(Fit, EveryFitterContainsEverySphere) {
     }
 }
 
+TEST(Fit, APolicyAllowingNoKindStillEnclosesTheSpheres) {
+    // It gave an empty box at the origin; it is read as every kind allowed (builders refuse it first).
+    VolumePolicy none = VolumePolicy::all();
+    none.allowed.fill(false);
+    for (const SphereSet& set : all_sets()) {
+        const BoundingVolume fitted = fit_best(set.spheres, none, set.hints);
+        expect_contains_all(fitted, set, "fit_best under no kind");
+        EXPECT_EQ(volume(fitted), volume(fit_best(set.spheres, VolumePolicy::all(), set.hints)));
+    }
+}
+
 TEST(Fit, ObbIsNoLargerThanAabbOrCovarianceBoxAndProper) {
     for (const SphereSet& set : all_sets()) {
         const Obb box = fit_obb(set.spheres, set.hints);

@@ -48,6 +48,15 @@ TEST(ValidatePrimitives, NamesTheIndexNameAndProblem) {
     EXPECT_NE(message.find("negative"), std::string::npos) << message;
 }
 
+TEST(ValidatePrimitives, RefusesANameWithANulByte) {
+    // XML and .hbvh both end a name at a NUL: saved, "a\0b" came back as "a" without a word.
+    const std::vector<Primitive> primitives{{Sphere{Vec3(0, 0, 0), 1.0}, "ok"},
+                                            {Sphere{Vec3(3, 0, 0), 1.0}, std::string("a\0b", 3)}};
+    const Status status = validate_primitives(primitives);
+    ASSERT_FALSE(status);
+    EXPECT_EQ(status.error().message, "primitive 1: its name holds a NUL byte, which no hierarchy file keeps");
+}
+
 TEST(ValidatePrimitives, RefusesEveryKindOfBadNumber) {
     Mat3 shear = Mat3::Identity();
     shear(0, 1) = 1e-6;
@@ -92,6 +101,12 @@ TEST(ValidatePose, RefusesNonRigidMotions) {
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(0, 0, 0, 0)));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(nan, 0, 0, 1)));
     EXPECT_FALSE(validate_pose(RigidTransform::from_quaternion(std::numeric_limits<double>::infinity(), 0, 0, 1)));
+    // Any finite non-zero quaternion is a rotation, also one whose length no double holds (2e308 gave NaN).
+    const RigidTransform huge = RigidTransform::from_quaternion(1e308, 1e308, 1e308, 1e308);
+    ASSERT_TRUE(validate_pose(huge));
+    const RigidTransform one = RigidTransform::from_quaternion(1, 1, 1, 1);
+    EXPECT_LT((huge.rotation - one.rotation).cwiseAbs().maxCoeff(), 1e-15);
+    EXPECT_TRUE(validate_pose(RigidTransform::from_quaternion(1e-310, 0, 0, 1e-310)));
 }
 
 TEST(ValidatePose, AnyNonZeroFiniteQuaternionGivesTheRotationOfItsDirection) {

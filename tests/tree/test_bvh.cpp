@@ -46,6 +46,9 @@ TEST(TreeAssembler, LaysOutBreadthFirstWithContiguousChildren) {
     EXPECT_EQ(level_view[1], (std::vector<std::uint32_t>{1, 2}));
     EXPECT_EQ(level_view[2].size(), 4u);
     EXPECT_EQ(covered_primitives(bvh, 2), (std::vector<std::uint32_t>{2, 3}));
+    // No such node covers nothing (it read past the array and crashed).
+    EXPECT_TRUE(covered_primitives(bvh, static_cast<std::uint32_t>(bvh.nodes.size())).empty());
+    EXPECT_TRUE(covered_primitives(bvh, 1000).empty());
     EXPECT_TRUE(validate(bvh).has_value());
 }
 

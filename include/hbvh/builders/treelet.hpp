@@ -43,7 +43,8 @@ struct TreeletReport {
 /// inner BVs fit_best over the covered primitives (or the existing BV where it is smaller), is found by
 /// solve_optimal_hierarchy and replaces the treelet when strictly cheaper. So the result's cost under
 /// `policy` is never above the input's, and it is exactly optimal when max_units >= the primitive count.
-/// Deterministic for any TBB thread count. An empty or single-leaf input is returned unchanged.
+/// Deterministic for any TBB thread count. An empty or single-leaf input is returned unchanged, and so is any
+/// input under a policy validate_policy refuses (one that allows no kind gave volumes around nothing).
 [[nodiscard]] Bvh refine_treelets(const Bvh& bvh, const VolumePolicy& policy, const TreeletOptions& options = {},
                                   TreeletReport* report = nullptr);
 

@@ -31,7 +31,9 @@ namespace hbvh {
 [[nodiscard]] Capsule fit_capsule(std::span<const Sphere> spheres, std::span<const Mat3> hint_axes = {});
 /// The fitter for one kind.
 [[nodiscard]] BoundingVolume fit(BvType type, std::span<const Sphere> spheres, std::span<const Mat3> hint_axes = {});
-/// The allowed kind with the smallest weighted volume.
+/// The allowed kind with the smallest weighted volume. A policy that allows no kind is read as allowing every
+/// kind (a volume must enclose the spheres; that one was an empty box at the origin); builders refuse such a
+/// policy first (validate_policy).
 [[nodiscard]] BoundingVolume fit_best(std::span<const Sphere> spheres, const VolumePolicy& policy,
                                       std::span<const Mat3> hint_axes = {});
 

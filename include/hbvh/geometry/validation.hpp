@@ -29,7 +29,8 @@ inline constexpr double rotation_tolerance = 1e-9;
 /// subnormal sizes (they vanish in the first product), rotations that are no proper rotation.
 /// Zero sizes are fine: a flat box, a point sphere, a capsule with p0 == p1 (a sphere).
 [[nodiscard]] std::string volume_problem(const BoundingVolume& volume);
-/// Ok, or an Error naming the first bad primitive: "primitive 3 ('leg'): radius -0.5 is negative".
+/// Ok, or an Error naming the first bad primitive: "primitive 3 ('leg'): radius -0.5 is negative". A name
+/// holding a NUL byte is refused too (no hierarchy file keeps it).
 [[nodiscard]] Status validate_primitives(std::span<const Primitive> primitives);
 /// validate_pose(pose) is Ok, without building a message: cheap enough to run on every query.
 [[nodiscard]] bool is_rigid_motion(const RigidTransform& pose);

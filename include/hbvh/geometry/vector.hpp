@@ -43,11 +43,14 @@ struct RigidTransform {
     /// which validate_pose() and collide() refuse.
     [[nodiscard]] static RigidTransform from_quaternion(double w, double x, double y, double z,
                                                         const Vec3& translation = Vec3::Zero()) {
-        const Eigen::Quaterniond q(w, x, y, z);
-        const double norm = detail::length_of(q.coeffs());  // components of 1e300 or 1e-300 too
-        if (!(norm > 0.0) || !std::isfinite(norm))
+        // Scaled by its largest part first: components of 1e300 or 1e-300 too, and of 1e308, whose length
+        // (2e308) no double holds.
+        const Eigen::Vector4d parts(x, y, z, w);
+        const double largest = parts.cwiseAbs().maxCoeff();
+        if (!(largest > 0.0) || !std::isfinite(largest))
             return {Mat3::Constant(std::numeric_limits<double>::quiet_NaN()), translation};
-        return {Eigen::Quaterniond(q.coeffs() / norm).toRotationMatrix(), translation};
+        const Eigen::Vector4d scaled = parts / largest;
+        return {Eigen::Quaterniond(scaled / scaled.norm()).toRotationMatrix(), translation};
     }
 };
 

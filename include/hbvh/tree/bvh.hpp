@@ -36,7 +36,8 @@ struct Bvh {
 
 /// Nodes grouped by depth: levels[d] lists the indices of all nodes at depth d (root at 0).
 [[nodiscard]] std::vector<std::vector<std::uint32_t>> levels(const Bvh& bvh);
-/// Input indices of the primitives below node `index`, ascending.
+/// The input primitives under node `index`, ascending. Empty for an index past the nodes; children past the
+/// array (a malformed tree: check_structure says which) are skipped.
 [[nodiscard]] std::vector<std::uint32_t> covered_primitives(const Bvh& bvh, std::uint32_t index);
 
 /// Assembles a Bvh from groups made in any order, as bottom-up, top-down and incremental builders do.
