@@ -23,7 +23,9 @@ struct BuildReport {
     std::vector<LevelReport> levels;
     std::uint32_t total_candidates = 0;
     bool budget_hit = false;            ///< Any level hit its budget.
-    double lower_bound = 0.0;           ///< Proven lower bound on the cost, where the builder knows one (else 0).
+    /// Proven lower bound on the cost of every tree whose inner volumes are fit_best's over what they cover, where
+    /// the builder knows one (else 0). Volumes fitted otherwise can make a cheaper tree (docs/solver.md §2).
+    double lower_bound = 0.0;
     std::vector<std::string> notes;     ///< Free-form remarks (fallbacks, choices made by `auto`).
     /// The registry name of the builder whose tree was returned when it is not the one asked for (`optimal`
     /// above its primitive limit returns bnb-exact's); empty otherwise.
