@@ -138,17 +138,6 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
     ASSERT_EQ(imported->warnings.size(), 1u);
     EXPECT_NE(imported->warnings[0].find("cone.urdf:3: collision with unknown geometry <cone>"), std::string::npos)
         << imported->warnings[0];
-    // Two shapes in one <geometry>: the first is read, as the warning says, even when a <capsule> follows (it
-    // replaced the box).
-    const fs::path two_shapes = folder / "two_shapes.urdf";
-    std::ofstream(two_shapes) << "<robot name=\"r\">\n<link name=\"a\">\n<collision><geometry><box size=\"1 1 1\"/>"
-                                 "<capsule radius=\"0.1\" length=\"0.5\"/></geometry></collision></link>\n</robot>";
-    const Result<ImportResult> first_shape = import_urdf(two_shapes.string());
-    ASSERT_TRUE(first_shape.has_value()) << first_shape.error().to_string();
-    ASSERT_EQ(first_shape->primitives.size(), 1u);
-    EXPECT_TRUE(std::holds_alternative<Obb>(first_shape->primitives[0].volume));
-    ASSERT_EQ(first_shape->warnings.size(), 1u);
-    EXPECT_NE(first_shape->warnings[0].find("only the first, <box>"), std::string::npos) << first_shape->warnings[0];
     // Blanks around a number, which urdfdom refuses, are read: the number is handed on in a form it takes.
     const fs::path padded = folder / "padded.urdf";
     std::ofstream(padded) << "<robot name=\"r\">\n<link name=\"a\"><collision><origin xyz=\" 1 2 3 \"/><geometry>"
@@ -158,18 +147,33 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
     ASSERT_EQ(blanks->primitives.size(), 1u);
     EXPECT_EQ(std::get<Sphere>(blanks->primitives[0].volume).radius, 0.5);
     EXPECT_EQ(std::get<Sphere>(blanks->primitives[0].volume).center, Vec3(1, 2, 3));
-    // A second shape in one <geometry> is dropped by urdfdom: the import says so, at the geometry's line.
-    const fs::path two = folder / "two.urdf";
-    std::ofstream(two) << "<robot name=\"r\">\n<link name=\"a\">\n<collision>\n<geometry><sphere radius=\"1\"/>"
-                          "<box size=\"1 1 1\"/></geometry>\n</collision></link>\n</robot>";
-    const Result<ImportResult> first_only = import_urdf(two.string());
-    ASSERT_TRUE(first_only.has_value()) << first_only.error().to_string();
-    ASSERT_EQ(first_only->primitives.size(), 1u);
+    // A second shape in one <geometry> is dropped by urdfdom: the import says so, at the geometry's line. The first
+    // is read also when a <capsule> follows (the capsule replaced the box).
+    const auto import_two_shapes = [&](const std::string& name, const std::string& shapes) {
+        const fs::path file = folder / name;
+        std::ofstream(file) << "<robot name=\"r\">\n<link name=\"a\">\n<collision>\n<geometry>" << shapes
+                            << "</geometry>\n</collision></link>\n</robot>";
+        const Result<ImportResult> imported = import_urdf(file.string());
+        EXPECT_TRUE(imported.has_value()) << imported.error().to_string();
+        if (imported) {
+            EXPECT_EQ(imported->primitives.size(), 1u);
+            EXPECT_EQ(imported->warnings.size(), 1u);
+        }
+        return imported;
+    };
+    const Result<ImportResult> first_only = import_two_shapes("two.urdf", "<sphere radius=\"1\"/><box size=\"1 1 1\"/>");
+    ASSERT_TRUE(first_only.has_value() && first_only->primitives.size() == 1 && first_only->warnings.size() == 1);
     EXPECT_TRUE(std::holds_alternative<Sphere>(first_only->primitives[0].volume));
-    ASSERT_EQ(first_only->warnings.size(), 1u);
     EXPECT_NE(first_only->warnings[0].find("two.urdf:4: <geometry> holds 2 shapes; only the first, <sphere>, is read"),
               std::string::npos)
         << first_only->warnings[0];
+    const Result<ImportResult> box_first =
+        import_two_shapes("two_shapes.urdf", "<box size=\"1 1 1\"/><capsule radius=\"0.1\" length=\"0.5\"/>");
+    ASSERT_TRUE(box_first.has_value() && box_first->primitives.size() == 1 && box_first->warnings.size() == 1);
+    EXPECT_TRUE(std::holds_alternative<Obb>(box_first->primitives[0].volume));
+    EXPECT_NE(box_first->warnings[0].find("two_shapes.urdf:4: <geometry> holds 2 shapes; only the first, <box>, is read"),
+              std::string::npos)
+        << box_first->warnings[0];
     fs::remove_all(folder);
 }
 
