@@ -153,13 +153,13 @@ TEST(Urdf, ErrorsNameFileLineAndProblem) {
         const fs::path file = folder / name;
         std::ofstream(file) << "<robot name=\"r\">\n<link name=\"a\">\n<collision>\n<geometry>" << shapes
                             << "</geometry>\n</collision></link>\n</robot>";
-        const Result<ImportResult> imported = import_urdf(file.string());
-        EXPECT_TRUE(imported.has_value()) << imported.error().to_string();
-        if (imported) {
-            EXPECT_EQ(imported->primitives.size(), 1u);
-            EXPECT_EQ(imported->warnings.size(), 1u);
+        const Result<ImportResult> read = import_urdf(file.string());
+        EXPECT_TRUE(read.has_value()) << read.error().to_string();
+        if (read) {
+            EXPECT_EQ(read->primitives.size(), 1u);
+            EXPECT_EQ(read->warnings.size(), 1u);
         }
-        return imported;
+        return read;
     };
     const Result<ImportResult> first_only = import_two_shapes("two.urdf", "<sphere radius=\"1\"/><box size=\"1 1 1\"/>");
     ASSERT_TRUE(first_only.has_value() && first_only->primitives.size() == 1 && first_only->warnings.size() == 1);
