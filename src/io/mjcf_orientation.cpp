@@ -9,6 +9,8 @@ namespace {
 
 // Below this length a direction carries no information; MuJoCo uses a similar cut-off (mjMINVAL).
 constexpr double tiny_length = 1e-14;
+/// Below this sine between a zaxis (or fromto) direction and +-z, MuJoCo takes the direction as exactly +-z.
+constexpr double mujoco_parallel_sine = 1e-7;
 
 using detail::length_of;  // a quaternion or axis of 1e160 parts is as valid as one of 1
 
@@ -69,8 +71,11 @@ std::optional<Mat3> rotation_from_z_axis(const Vec3& z) {
     const Vec3 direction = z / length;
     const Vec3 axis = Vec3::UnitZ().cross(direction);
     const double sine = axis.norm();
-    if (sine < tiny_length) {
-        // Parallel to z: identity, or a half turn about x for -z.
+    if (sine < mujoco_parallel_sine) {
+        // Parallel to z: identity, or a half turn about x for -z. MuJoCo 2.2.2 counts a direction as parallel
+        // up to a sine of 1e-7 (measured with mj_loadXML on zaxis and fromto; tests/io/data/mjcf_orientations.xml
+        // holds a box on each side of it): near -z the turn's axis is ill-conditioned, and about any other axis
+        // a box with unequal x and y sizes would come out turned by up to 90 degrees about z.
         if (direction.z() >= 0.0) return Mat3::Identity();
         return Mat3(Vec3(1.0, -1.0, -1.0).asDiagonal());
     }
