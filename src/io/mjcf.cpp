@@ -478,6 +478,20 @@ private:
         if (uses_fromto) {
             Result<std::vector<double>> ends = numbers(fromto, "fromto", 6);
             if (!ends) return ends.error();
+            // fromto sets the centre, so a pos beside it (the geom's or its class's) would be dropped without a
+            // word; MuJoCo 2.2.2 refuses a non-zero one ("both pos and fromto defined"), whichever level gives
+            // either, and so do we.
+            if (const FoundAttribute pos = find_attribute(geom, chain, "pos"); pos.value != nullptr) {
+                Result<std::vector<double>> p = numbers(pos, "pos", 3);
+                if (!p) return p.error();
+                if ((*p)[0] != 0.0 || (*p)[1] != 0.0 || (*p)[2] != 0.0) {
+                    const XmlSource& where = source_of(fromto.element);
+                    return error_at(pos.element, "pos and fromto (at " + where.path() + ":" +
+                                                     std::to_string(where.line_of(fromto.element)) +
+                                                     ") are both given; fromto sets the centre, and MuJoCo refuses "
+                                                     "the pair: drop pos, or move the segment");
+                }
+            }
             const Vec3 from((*ends)[0], (*ends)[1], (*ends)[2]);
             const Vec3 to((*ends)[3], (*ends)[4], (*ends)[5]);
             // MuJoCo turns z onto from - to (checked against mj_forward of 2.2.2): a box's or ellipsoid's x and y

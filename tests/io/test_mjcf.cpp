@@ -417,6 +417,51 @@ TEST(Mjcf, ErrorsNameFileLineAndProblem) {
     EXPECT_NE(missing.error().message.find("cannot open"), std::string::npos);
 }
 
+// fromto sets the centre: a non-zero pos beside it, from the geom or its class, is refused as MuJoCo refuses it (until
+// 2026-12-07 the pos was dropped without a word), and a zero pos is accepted as MuJoCo accepts it. MuJoCo is the
+// oracle of each verdict; the error names the line of the pos and the place of the fromto.
+TEST(Mjcf, PosBesideFromtoIsRefusedAsInMuJoCo) {
+    struct Case {
+        std::string text;
+        int pos_line;  // 0: accepted
+        int fromto_line;
+    };
+    const std::string rod_class = "<default>\n<default class=\"rod\">\n<geom type=\"capsule\" size=\"0.02\" "
+                                  "fromto=\"0 0 0 0 0 -0.5\"/>\n</default>\n</default>\n";
+    const std::vector<Case> cases{
+        {"<mujoco>\n<worldbody>\n<geom type=\"capsule\" size=\"0.02\" fromto=\"0 0 0 0 0 -0.5\" pos=\"1 2 3\"/>\n"
+         "</worldbody>\n</mujoco>", 3, 3},
+        {"<mujoco>\n" + rod_class + "<worldbody>\n<geom class=\"rod\" pos=\"0 0 0.1\"/>\n</worldbody>\n</mujoco>", 8, 4},
+        {"<mujoco>\n<default>\n<default class=\"p\">\n<geom type=\"capsule\" size=\"0.02\" pos=\"1 0 0\"/>\n</default>\n"
+         "</default>\n<worldbody>\n<geom class=\"p\" fromto=\"0 0 0 0 0 -0.5\"/>\n</worldbody>\n</mujoco>", 4, 8},
+        {"<mujoco>\n<worldbody>\n<geom type=\"capsule\" size=\"0.02\" fromto=\"0 0 0 0 0 -0.5\" pos=\"0 0 0\"/>\n"
+         "</worldbody>\n</mujoco>", 0, 3},
+        {"<mujoco>\n" + rod_class + "<worldbody>\n<geom class=\"rod\" euler=\"10 0 0\"/>\n</worldbody>\n</mujoco>", 0, 4},
+    };
+    TempDir folder;
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+        const fs::path file = folder.path / ("case" + std::to_string(i) + ".xml");
+        std::ofstream(file) << cases[i].text;
+        std::string why;
+        const bool mujoco_accepts = load_with_mujoco(file, why).has_value();
+        const Result<ImportResult> imported = import_mjcf(file.string());
+        EXPECT_EQ(imported.has_value(), mujoco_accepts) << cases[i].text << "\nMuJoCo: " << why;
+        EXPECT_EQ(imported.has_value(), cases[i].pos_line == 0) << cases[i].text;
+        if (imported.has_value()) {
+            ASSERT_EQ(imported->primitives.size(), 1u);
+            const auto* capsule = std::get_if<Capsule>(&imported->primitives[0].volume);
+            ASSERT_NE(capsule, nullptr);
+            EXPECT_NEAR(0.5 * (capsule->p0 + capsule->p1).z(), -0.25, 1e-12);  // the segment's middle, not pos
+            continue;
+        }
+        EXPECT_EQ(imported.error().line, cases[i].pos_line) << imported.error().to_string();
+        EXPECT_NE(imported.error().message.find("pos and fromto (at " + file.string() + ":" +
+                                                std::to_string(cases[i].fromto_line) + ") are both given"),
+                  std::string::npos)
+            << imported.error().to_string();
+    }
+}
+
 TEST(Mjcf, AbsurdNestingIsAnErrorNotACrash) {
     TempDir folder;
     std::string text = "<mujoco><worldbody>";
