@@ -9,6 +9,7 @@
 #include <atomic>
 #include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <system_error>
 
 #include "memory/huge_pages.hpp"
@@ -82,6 +83,71 @@ Status write_into_stream(const std::filesystem::path& path, std::string_view con
     if (const int code = stream.close_checked(); code != 0) return Error("cannot write: " + describe(code), name);
     return Ok{};
 }
+
+/// The temporary files being written, for remove_pending_temporary_files (a signal handler): fixed slots, so
+/// that the handler reads them without locks or allocation. A writer claims a free slot, copies the path in, and
+/// only then publishes it; the handler unlinks what is published.
+class PendingTemporaries {
+public:
+    static constexpr std::size_t slots = 64;
+    static constexpr std::size_t path_bytes = 4096;  // PATH_MAX on Linux
+
+    /// Records `path`; the slot number to release, or `slots` when none is free or the path is too long.
+    std::size_t add(const std::filesystem::path& path) noexcept {
+        const std::string& text = path.native();
+        if (text.size() >= path_bytes) return slots;
+        for (std::size_t i = 0; i < slots; ++i) {
+            bool expected = false;
+            if (!claimed_[i].compare_exchange_strong(expected, true, std::memory_order_acquire)) continue;
+            std::memcpy(paths_[i], text.c_str(), text.size() + 1);
+            published_[i].store(true, std::memory_order_release);
+            return i;
+        }
+        return slots;
+    }
+
+    /// Forgets slot `i` (after the rename, or after the file was removed).
+    void release(std::size_t i) noexcept {
+        if (i >= slots) return;
+        published_[i].store(false, std::memory_order_release);
+        claimed_[i].store(false, std::memory_order_release);
+    }
+
+    /// Unlinks every published path. Async-signal-safe: lock-free atomics, reads and unlink only.
+    void remove_all() noexcept {
+        for (std::size_t i = 0; i < slots; ++i)
+            if (published_[i].exchange(false, std::memory_order_acq_rel)) ::unlink(paths_[i]);
+    }
+
+private:
+    std::atomic<bool> claimed_[slots]{};
+    std::atomic<bool> published_[slots]{};
+    char paths_[slots][path_bytes]{};
+};
+static_assert(std::atomic<bool>::is_always_lock_free, "the signal handler needs lock-free flags");
+
+/// Constant-initialised (zeros, in .bss), so a handler that runs before any write finds it ready: a function's
+/// static would be made on first use, behind a lock no signal handler may take.
+constinit PendingTemporaries pending_temporaries_of_the_process;
+
+PendingTemporaries& pending_temporaries() { return pending_temporaries_of_the_process; }
+
+/// Holds a PendingTemporaries slot until done() or scope exit.
+class PendingSlot {
+public:
+    explicit PendingSlot(const std::filesystem::path& path) : slot_(pending_temporaries().add(path)) {}
+    PendingSlot(const PendingSlot&) = delete;
+    PendingSlot& operator=(const PendingSlot&) = delete;
+    ~PendingSlot() { done(); }
+    /// The file is renamed or removed: nothing is left for a handler to remove.
+    void done() noexcept {
+        pending_temporaries().release(slot_);
+        slot_ = PendingTemporaries::slots;
+    }
+
+private:
+    std::size_t slot_;
+};
 
 /// A name for the temporary file that no other writer (thread or process) picks at the same time.
 /// Hidden (leading dot) so directory listings and globs don't catch a half-written file.
@@ -159,6 +225,8 @@ Status replace_file(const std::filesystem::path& path, std::string_view content,
     }
     if (fd < 0) return Error("cannot create a temporary file next to it: " + describe(errno), name);
     FileDescriptor file(fd);
+    // Until the rename (or the unlink on failure), a signal handler may remove the file.
+    PendingSlot pending(temporary);
     auto fail = [&](std::string what, int code) -> Status {
         ::unlink(temporary.c_str());
         return Error(std::move(what) + ": " + describe(code), name);
@@ -174,6 +242,7 @@ Status replace_file(const std::filesystem::path& path, std::string_view content,
 
     // Stage 3: publish. rename() replaces the target in one step; after it the content is in place.
     if (::rename(temporary.c_str(), path.c_str()) != 0) return fail("cannot replace the file", errno);
+    pending.done();
 
     // Make the rename itself durable. Best effort: the file is already complete and in place, and some
     // file systems refuse fsync on directories, so a failure here is not an error.
@@ -187,6 +256,8 @@ Status replace_file(const std::filesystem::path& path, std::string_view content,
 }
 
 }  // namespace
+
+void remove_pending_temporary_files() noexcept { pending_temporaries().remove_all(); }
 
 Status write_file_atomic(const std::filesystem::path& path, std::string_view content) {
     const std::string name = path.string();

@@ -8,10 +8,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace hbvh {
@@ -81,6 +84,38 @@ TEST_F(FileTest, FailureLeavesNothingBehind) {
     EXPECT_EQ(status.error().message, "is a directory, not a file: give the output a file name");
     EXPECT_EQ(entries(), std::vector<std::string>{"taken"});
     EXPECT_TRUE(fs::is_empty(target));
+}
+
+// What a signal handler calls (the CLI's, on SIGINT, SIGTERM and SIGHUP): the temporary file of a write under way
+// goes, the old file stays, and the write, when it resumes, fails instead of putting anything in place.
+TEST_F(FileTest, PendingTemporaryFilesCanBeRemovedMidWrite) {
+    const fs::path target = directory_ / "out.xml";
+    ASSERT_TRUE(write_file_atomic(target, "old"));
+    const std::string content(std::size_t{256} << 20, 'x');  // long enough to be seen in flight
+    Status status = Ok{};
+    std::atomic<bool> finished{false};
+    std::thread writer([&] {
+        status = write_file_atomic(target, content);
+        finished = true;
+    });
+    bool seen = false;
+    while (!seen && !finished) {
+        for (const std::string& name : entries()) seen = seen || name.rfind(".out.xml.tmp-", 0) == 0;
+        if (!seen) std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+    if (seen) remove_pending_temporary_files();
+    writer.join();
+    ASSERT_TRUE(seen) << "the write ended before its temporary file was seen";
+    ASSERT_FALSE(status);
+    EXPECT_NE(status.error().message.find("cannot replace the file"), std::string::npos) << status.error().to_string();
+    EXPECT_EQ(entries(), std::vector<std::string>{"out.xml"});
+    const Result<std::string> kept = read_text_file(target);
+    ASSERT_TRUE(kept) << kept.error().to_string();
+    EXPECT_EQ(*kept, "old");
+    // With nothing in flight it does nothing, and later writes are unaffected.
+    remove_pending_temporary_files();
+    ASSERT_TRUE(write_file_atomic(target, "new"));
+    EXPECT_EQ(*read_text_file(target), "new");
 }
 
 TEST_F(FileTest, DotAndDotDotAreRefusedAsDirectories) {

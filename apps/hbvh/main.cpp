@@ -1,16 +1,46 @@
 // SPDX-License-Identifier: MIT
 // hbvh: builds and queries heterogeneous bounding-volume hierarchies from the command line.
 #include <CLI/CLI.hpp>
+#include <signal.h>
+
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <new>
 
 #include "commands/command.hpp"
+#include "hbvh/files.hpp"
 #include "hbvh/io/xml_memory.hpp"
 #include "hbvh/version.hpp"
 
+namespace {
+
+/// Ctrl-C, kill or a closed terminal in the middle of writing an output: the temporary file goes (the output is
+/// still the old one or absent, as for any failed write), then the signal takes its usual course, so the exit
+/// status still says which signal ended the process.
+extern "C" void end_on_signal(int signal_number) {
+    hbvh::remove_pending_temporary_files();
+    std::signal(signal_number, SIG_DFL);
+    std::raise(signal_number);
+}
+
+void remove_temporaries_on_termination_signals() {
+    for (const int signal_number : {SIGINT, SIGTERM, SIGHUP}) {
+        struct sigaction action {};
+        action.sa_handler = end_on_signal;
+        sigemptyset(&action.sa_mask);
+        // A signal that was ignored when the process started (nohup, a shell's background job) stays ignored.
+        struct sigaction previous {};
+        if (::sigaction(signal_number, nullptr, &previous) == 0 && previous.sa_handler == SIG_IGN) continue;
+        ::sigaction(signal_number, &action, nullptr);
+    }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
     using namespace hbvh::cli;
+    remove_temporaries_on_termination_signals();
     // The program owns its process, so it may set pugixml's process-wide allocator: a large XML file's DOM
     // then lands on huge pages (reading 10^6 primitives took a third of the time on a host with costly page faults).
     hbvh::use_huge_pages_for_xml();

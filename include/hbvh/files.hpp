@@ -26,4 +26,12 @@ namespace hbvh {
 /// to), through that descriptor; and a device, fifo or socket (`/dev/null`, a pipe). POSIX only.
 [[nodiscard]] Status write_file_atomic(const std::filesystem::path& path, std::string_view content);
 
+/// Removes the temporary files of the write_file_atomic calls under way in this process, leaving their targets as
+/// they were. For a program's handler of SIGINT, SIGTERM or SIGHUP, which would otherwise leave a hidden
+/// `.NAME.tmp-...` file behind when it ends the process in the middle of a write: async-signal-safe (it only reads
+/// fixed slots and calls unlink), and after it each interrupted write fails if it resumes. The library installs no
+/// signal handler itself; the hbvh CLI does (docs/formats.md, "Writing files safely"). Up to 64 writes at once
+/// are tracked; a program with more in flight keeps the old behaviour for the rest.
+void remove_pending_temporary_files() noexcept;
+
 }  // namespace hbvh
