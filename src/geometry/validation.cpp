@@ -133,10 +133,14 @@ Status validate_primitives(std::span<const Primitive> primitives) {
 
 bool is_rigid_motion(const RigidTransform& pose) { return pose.translation.allFinite() && is_rotation(pose.rotation); }
 
+std::string pose_problem(const RigidTransform& pose) {
+    if (is_rigid_motion(pose)) return {};
+    if (!pose.translation.allFinite()) return "translation is not finite";
+    return rotation_problem(pose.rotation);
+}
+
 Status validate_pose(const RigidTransform& pose) {
-    if (is_rigid_motion(pose)) return Ok{};
-    if (!pose.translation.allFinite()) return Error{"pose: translation is not finite"};
-    if (std::string problem = rotation_problem(pose.rotation); !problem.empty()) return Error{"pose: " + problem};
+    if (std::string problem = pose_problem(pose); !problem.empty()) return Error{"pose: " + problem};
     return Ok{};
 }
 

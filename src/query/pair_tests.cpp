@@ -23,8 +23,8 @@ void reset(CollideResult& result) {
 bool poses_valid(const RigidTransform& pose_a, const RigidTransform& pose_b, CollideResult& result) {
     if (is_rigid_motion(pose_a) && is_rigid_motion(pose_b)) return true;  // the words only when needed
     for (const RigidTransform* pose : {&pose_a, &pose_b}) {
-        if (Status valid = validate_pose(*pose); !valid) {
-            result.error = Error{(pose == &pose_a ? "pose_a: " : "pose_b: ") + valid.error().message};
+        if (std::string problem = pose_problem(*pose); !problem.empty()) {
+            result.error = Error{(pose == &pose_a ? "pose_a: " : "pose_b: ") + problem};
             return false;
         }
     }

@@ -59,7 +59,7 @@ Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
     if (quaternion.norm() < 1e-12) return Error{std::string(flag) + ": the quaternion is zero"};
     numbers[3] = quaternion[0], numbers[4] = quaternion[1], numbers[5] = quaternion[2], numbers[6] = quaternion[3];
     const RigidTransform pose = RigidTransform::from_quaternion(numbers[3], numbers[4], numbers[5], numbers[6], translation);
-    if (Status valid = validate_pose(pose); !valid) return Error{std::string(flag) + ": " + valid.error().message};
+    if (std::string problem = pose_problem(pose); !problem.empty()) return Error{std::string(flag) + ": " + problem};
     return pose;
 }
 

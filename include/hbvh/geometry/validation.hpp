@@ -34,7 +34,10 @@ inline constexpr double rotation_tolerance = 1e-9;
 [[nodiscard]] Status validate_primitives(std::span<const Primitive> primitives);
 /// validate_pose(pose) is Ok, without building a message: cheap enough to run on every query.
 [[nodiscard]] bool is_rigid_motion(const RigidTransform& pose);
-/// Ok, or an Error saying why `pose` is no rigid motion (non-finite numbers, no proper rotation).
+/// Empty, or why `pose` is no rigid motion ("translation is not finite", or rotation_problem's words), for a
+/// caller that names the pose itself ("pose_a: ...", "--pose: ...").
+[[nodiscard]] std::string pose_problem(const RigidTransform& pose);
+/// Ok, or an Error "pose: " + pose_problem(pose).
 [[nodiscard]] Status validate_pose(const RigidTransform& pose);
 
 }  // namespace hbvh
