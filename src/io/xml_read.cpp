@@ -29,6 +29,7 @@
 #include "hbvh/geometry/validation.hpp"
 #include "hbvh/io/file.hpp"
 #include "../memory/huge_pages.hpp"
+#include "xml_fields.hpp"
 #include "xml_number.hpp"
 #include "xml_source.hpp"
 #include "xml_taking.hpp"
@@ -36,7 +37,9 @@
 namespace hbvh {
 namespace {
 
+using detail::aabb_from_fields;
 using detail::append_number;
+using detail::capsule_from_fields;
 
 // The attributes of a <volume>. Everything else is rejected: silently ignoring a misspelt `orientaton`
 // would turn an OBB into an AABB without a word. `position` (the survey's prose) is read as `pos`.
@@ -584,8 +587,7 @@ Result<BoundingVolume> Reader::read_round(const pugi::xml_node& element, const V
     // Length 0 is a sphere written as a capsule; that is still a valid capsule.
     const Result<double> length = read_size(element, *length_attribute);
     if (!length) return length.error();
-    const Vec3 half_axis = (0.5 * *length) * Vec3(*direction / norm);
-    const Capsule capsule{centre - half_axis, centre + half_axis, *radius};
+    const Capsule capsule = capsule_from_fields(centre, *direction, *length, *radius);
     if (!capsule.p0.allFinite() || !capsule.p1.allFinite())
         return error(line_of(element), "capsule ends overflow the range of double");
     return BoundingVolume(capsule);
@@ -610,7 +612,7 @@ Result<BoundingVolume> Reader::read_box(const pugi::xml_node& element, const Vol
     if (!orientation_attribute) {
         // Stored as corners, an AABB can lose what the file says: far from the origin a small extent
         // rounds away, and a huge one overflows. Refuse instead of returning a flat or infinite box.
-        const Aabb box{centre - half, centre + half};
+        const Aabb box = aabb_from_fields(centre, extents);
         if (!box.min.allFinite() || !box.max.allFinite())
             return error(line_of(element), "box corners overflow the range of double");
         if (((box.max - box.min).array() <= 0.0 && extents.array() > 0.0).any())

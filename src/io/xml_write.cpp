@@ -15,12 +15,17 @@
 #include "hbvh/assert.hpp"
 #include "../memory/huge_pages.hpp"
 #include "../tree/utf8.hpp"
+#include "xml_fields.hpp"
 #include "xml_number.hpp"
 
 namespace hbvh {
 namespace {
 
+using detail::AabbFields;
 using detail::append_number;
+using detail::CapsuleFields;
+using detail::exact_aabb_fields;
+using detail::exact_capsule_fields;
 
 constexpr std::string_view declaration = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
 
@@ -90,11 +95,12 @@ void append_volume(Out& out, const BoundingVolume& bv, std::string_view name, st
     }
     std::visit(Overloaded{
                    [&](const Aabb& box) {
-                       const Vec3 extents = box.max - box.min;
-                       append_vector(out, "pos", box.center());
-                       append_numbers(out, "width", {extents.x()});
-                       append_numbers(out, "depth", {extents.y()});
-                       append_numbers(out, "height", {extents.z()});
+                       // Fields the reader turns back into these very corners (xml_fields.hpp).
+                       const AabbFields fields = exact_aabb_fields(box);
+                       append_vector(out, "pos", fields.centre);
+                       append_numbers(out, "width", {fields.extents.x()});
+                       append_numbers(out, "depth", {fields.extents.y()});
+                       append_numbers(out, "height", {fields.extents.z()});
                    },
                    [&](const Obb& box) {
                        const Vec3 extents = 2.0 * box.half_extents;
@@ -111,9 +117,10 @@ void append_volume(Out& out, const BoundingVolume& bv, std::string_view name, st
                        append_numbers(out, "radius", {sphere.radius});
                    },
                    [&](const Capsule& capsule) {
-                       append_vector(out, "pos", capsule.center());
-                       append_vector(out, "direction", capsule.direction());
-                       append_numbers(out, "length", {capsule.length()});
+                       const CapsuleFields fields = exact_capsule_fields(capsule);  // these very ends, read back
+                       append_vector(out, "pos", fields.centre);
+                       append_vector(out, "direction", fields.direction);
+                       append_numbers(out, "length", {fields.length});
                        append_numbers(out, "radius", {capsule.radius});
                    },
                },
