@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
+#include <optional>
 #include <system_error>
 
 #include "memory/huge_pages.hpp"
@@ -216,17 +217,21 @@ Status replace_file(const std::filesystem::path& path, std::string_view content,
         return Error("is a directory, not a file: give the output a file name", name);
     // Stage 1: create a fresh temporary file next to the target. Same directory means same file system,
     // which rename() needs to be atomic. O_EXCL guarantees we never write into someone else's file.
+    // Each name is registered for a signal handler to remove (remove_pending_temporary_files) before the file
+    // exists, so that no moment has the file on disk and unknown to the handler; a name that was taken (EEXIST:
+    // it holds this process's id, so hardly ever) is released before the next is tried.
     std::filesystem::path temporary;
+    std::optional<PendingSlot> pending;
     int fd = -1;
     for (unsigned attempt = 0; attempt < 100 && fd < 0; ++attempt) {
         temporary = temporary_name(path, attempt);
+        pending.emplace(temporary);
         fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd < 0) pending.reset();
         if (fd < 0 && errno != EEXIST && errno != EINTR) break;
     }
     if (fd < 0) return Error("cannot create a temporary file next to it: " + describe(errno), name);
     FileDescriptor file(fd);
-    // Until the rename (or the unlink on failure), a signal handler may remove the file.
-    PendingSlot pending(temporary);
     auto fail = [&](std::string what, int code) -> Status {
         ::unlink(temporary.c_str());
         return Error(std::move(what) + ": " + describe(code), name);
@@ -242,7 +247,7 @@ Status replace_file(const std::filesystem::path& path, std::string_view content,
 
     // Stage 3: publish. rename() replaces the target in one step; after it the content is in place.
     if (::rename(temporary.c_str(), path.c_str()) != 0) return fail("cannot replace the file", errno);
-    pending.done();
+    pending->done();
 
     // Make the rename itself durable. Best effort: the file is already complete and in place, and some
     // file systems refuse fsync on directories, so a failure here is not an error.
