@@ -36,10 +36,9 @@ std::optional<double> centre_between(double centre, double half, double low, dou
 }  // namespace
 
 AabbFields exact_aabb_fields(const Aabb& box) {
-    AabbFields nearest{box.center(), box.max - box.min};
+    const AabbFields nearest{box.center(), box.max - box.min};
     AabbFields fields = nearest;
     for (int axis = 0; axis < 3; ++axis) {
-        bool found = false;
         for (const int step : nearest_steps<3>()) {
             const double extent = stepped(nearest.extents[axis], step);
             if (!(extent >= 0.0)) continue;
@@ -47,11 +46,9 @@ AabbFields exact_aabb_fields(const Aabb& box) {
                     centre_between(nearest.centre[axis], 0.5 * extent, box.min[axis], box.max[axis])) {
                 fields.centre[axis] = *centre;
                 fields.extents[axis] = extent;
-                found = true;
                 break;
             }
         }
-        if (!found) fields.centre[axis] = nearest.centre[axis], fields.extents[axis] = nearest.extents[axis];
     }
     return fields;
 }

@@ -34,13 +34,15 @@ struct CapsuleFields {
     double length = 0.0;
 };
 
-/// Fields that aabb_from_fields turns back into `box` bit for bit: the centre and extents rounded to nearest, else
-/// the first pair within a few units in the last place of them that does (found for every box tried,
-/// tests/io/test_xml.cpp); the nearest ones where none does.
+/// Fields that aabb_from_fields turns back into `box` bit for bit, per axis: the centre and extent rounded to
+/// nearest, else the first pair within three units in the last place of them that does, else the nearest ones.
+/// Some boxes have none (corners an odd number of units in the last place apart, in the binade of the centre); the
+/// box the reader makes of the nearest fields then has such fields, so a box read back is written back the same.
 [[nodiscard]] AabbFields exact_aabb_fields(const Aabb& box);
 
-/// Likewise for capsule_from_fields: the centre, unit direction and length, with the length and the centre's
-/// components moved by a few units in the last place until the ends come back exactly, where they can.
+/// Likewise for capsule_from_fields: the centre, unit direction and length, with the length (up to four units in the
+/// last place) and the centre's components (up to three) moved until the ends come back exactly, where they can;
+/// the direction is not searched, so a capsule read back does not always come back exactly again.
 [[nodiscard]] CapsuleFields exact_capsule_fields(const Capsule& capsule);
 
 }  // namespace hbvh::detail
