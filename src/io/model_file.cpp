@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -174,9 +176,21 @@ Status check_model_file(const ModelFile& model, const std::string& source) {
     return Ok{};
 }
 
+Status check_finite_volumes(const Bvh& bvh, std::span<const int> node_lines, const std::string& source) {
+    for (std::uint32_t i = 0; i < bvh.nodes.size(); ++i) {
+        const BoundingVolume& bv = bvh.nodes[i].volume;
+        if (!std::isfinite(volume(bv)))
+            return Error{"volume (" + std::string(to_string(type_of(bv))) +
+                             ") is too large: its volume overflows double precision; scale the model down",
+                         source, line_of_node(node_lines, i)};
+    }
+    return Ok{};
+}
+
 Result<Bvh> enclosing_hierarchy(Bvh stored, std::span<const int> node_lines, const std::string& source,
                                 bool refit, std::string_view refit_option, std::size_t* refitted) {
     if (refitted != nullptr) *refitted = 0;
+    if (Status finite = check_finite_volumes(stored, node_lines, source); !finite) return finite.error();
     const std::vector<ContainmentViolation> violations = containment_violations(stored);
     if (violations.empty()) return stored;
     if (!refit) {

@@ -77,6 +77,14 @@ hbvh_cli_rejects(huge.xml "huge.xml: .*volumes overflow double precision")
 hbvh_cli_rejects(tiny.xml "tiny.xml: .*volumes underflow double precision")
 
 # Usage errors: exit 2 (bad arguments) or 1 (bad input file).
+# Finite numbers, infinite volumes: a stored root of radius 1e200 (every command that reads a stored tree), and
+# --type-weight weights that take a finite cost past double precision (stats printed cost null, exit 0).
+hbvh_cli_test(overflowing_root.stats 1 "overflowing_root.xml:2: volume \\(sphere\\) is too large: its volume overflows"
+              stats ${HBVH_CLI_INPUTS}/overflowing_root.xml --json)
+hbvh_cli_test(overflowing_root.collide 1 "overflowing_root.xml:2: volume \\(sphere\\) is too large"
+              collide ${HBVH_CLI_INPUTS}/overflowing_root.xml ${HBVH_CLI_INPUTS}/overflowing_root.xml)
+hbvh_cli_test(overflowing_weights.stats 1 "huge_spheres.xml: the cost overflows double precision: --type-weight"
+              stats ${HBVH_CLI_INPUTS}/huge_spheres.xml --type-weight aabb=1e6,obb=1e6,sphere=1e6,capsule=1e6)
 hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-not-exist.xml -o ${HBVH_CLI_OUT}/x.xml)
 # A directory whose name looks like a model is refused as a directory, not by its extension.
 file(MAKE_DIRECTORY ${HBVH_CLI_OUT}/a_directory.xml)

@@ -4,6 +4,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+
 #include "commands/command.hpp"
 #include "commands/json_text.hpp"
 #include "hbvh/tree/stats.hpp"
@@ -79,12 +81,19 @@ int run_stats(const StatsArguments& args) {
     warn_if_build_flags_unused(model.value(), args.builder, /*measured=*/true);
     Result<Bvh> bvh = model->hierarchy ? Result<Bvh>(*model->hierarchy) : request->run(model->primitives);
     if (!bvh) return report_error(bvh.error());
+    if (Status finite = check_finite_volumes(bvh.value(), model->node_lines, model->source); !finite)
+        return report_error(finite.error());
     const std::vector<ContainmentViolation> violations = containment_violations(bvh.value());
     // --type-weight weighs each volume of `cost` (and of `calibrated_cost`), as `build --stats` does; `cost` stays
     // Eq. 2's volume measure whatever --objective the tree was built for.
     VolumePolicy weighted = request->context.policy;
     weighted.measure = NodeMeasure::volume;
     const Stats stats = compute_stats(bvh.value(), weighted);
+    // Every volume is finite (above), so an infinite cost is the weights' doing.
+    if (!std::isfinite(stats.cost))
+        return report_error(Error{"the cost overflows double precision: --type-weight's weights times the volumes "
+                                  "exceed it; lower the weights",
+                                  model->source});
     if (args.json) {
         nlohmann::ordered_json out = to_json(stats);
         out["violations"] = violations_json(model.value(), bvh.value(), violations);

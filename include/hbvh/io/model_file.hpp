@@ -45,7 +45,13 @@ struct ModelFile {
 /// (check_structure). Errors carry `source` as their file.
 [[nodiscard]] Status check_model_file(const ModelFile& model, const std::string& source);
 
-/// A stored hierarchy fit to query: the tree itself when every volume encloses its primitives. Otherwise, without
+/// Ok, or an Error at the line of the first node whose volume overflows double precision: finite numbers can still
+/// make an infinite volume (a sphere of radius 1e200), and then the cost is inf (null in JSON) and every comparison
+/// of trees a tie. Built trees are kept from it by the builders' check of the primitives' extent.
+[[nodiscard]] Status check_finite_volumes(const Bvh& bvh, std::span<const int> node_lines, const std::string& source);
+
+/// A stored hierarchy fit to query: the tree itself when every volume encloses its primitives. A volume whose size
+/// overflows double precision (finite numbers, infinite volume) is an Error at its line. Otherwise, without
 /// `refit`, an Error naming the first volume that does not (at its line in a survey XML, from `node_lines`) and
 /// how many more there are, and saying that `refit_option` (the caller's name for the repair: "--refit" in the
 /// CLI) refits them; with `refit`, the tree with each such volume refitted (same kind, tree kept; refit.hpp), and
