@@ -41,9 +41,10 @@ struct Row {
     std::uint32_t height = 0;
     double relative = 0.0;  ///< cost / two-level cost
     std::optional<double> gap;  ///< cost / optimum - 1, when the model's optimum is known
-    std::optional<double> optimum;  ///< Set on `optimal` rows: the proven optimum's Eq. 2 cost
+    std::optional<double> optimum;  ///< Set on `optimal` rows that finished: the proven optimum's Eq. 2 cost
     bool budget_hit = false;
-    std::string error;
+    std::string error;    ///< The build failed: no numbers, and compare exits 1
+    std::string skipped;  ///< Not built, on purpose (--optimum-max-primitives): no numbers
 };
 
 /// "12.34 %" (or "-" when unknown) for the text and Markdown tables. A tree as cheap as the optimum may
@@ -119,7 +120,8 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const
         row.height = stats.height;
         row.candidates = report.total_candidates;
         row.budget_hit = report.budget_hit;
-        if (algorithm == Algorithm::optimal) row.optimum = stats.cost;
+        // An optimal build stopped by --time-limit returns a tree it could not prove optimal: no optimum, no gaps.
+        if (algorithm == Algorithm::optimal && !report.budget_hit) row.optimum = stats.cost;
         // A build that takes seconds is measured once: its median would not change the table.
         if (times.back() > 1000.0) break;
     }
@@ -132,8 +134,9 @@ void print_markdown(const std::vector<Row>& rows) {
     fmt::print("| model | algorithm | primitives | time (ms) | MC | cost | height | cost / two-level | gap to optimum |\n");
     fmt::print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for (const Row& row : rows) {
-        if (!row.error.empty()) {
-            fmt::print("| {} | {} | {} | error: {} | | | | | |\n", row.model, row.algorithm, row.primitives, row.error);
+        if (!row.error.empty() || !row.skipped.empty()) {
+            fmt::print("| {} | {} | {} | {} | | | | | |\n", row.model, row.algorithm, row.primitives,
+                       row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error);
             continue;
         }
         fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", row.model, row.algorithm,
@@ -146,8 +149,9 @@ void print_text(const std::vector<Row>& rows) {
     fmt::print("{:<20} {:<16} {:>6} {:>11} {:>6} {:>14} {:>6} {:>9} {:>10}\n", "model", "algorithm", "prims", "time-ms",
                "MC", "cost", "height", "vs-2lvl", "gap-opt");
     for (const Row& row : rows) {
-        if (!row.error.empty()) {
-            fmt::print("{:<20} {:<16} error: {}\n", row.model, row.algorithm, row.error);
+        if (!row.error.empty() || !row.skipped.empty()) {
+            fmt::print("{:<20} {:<16} {:>6} {}\n", row.model, row.algorithm, row.primitives,
+                       row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error);
             continue;
         }
         fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9.3f} {:>10}{}\n", row.model, row.algorithm,
@@ -165,7 +169,12 @@ void print_json(const std::vector<Row>& rows) {
                              {"budget_hit", row.budget_hit}};
         // A fraction (0.05 = 5 % above the optimum); null where the optimum is unknown.
         entry["gap_to_optimum"] = row.gap ? nlohmann::json(*row.gap) : nlohmann::json(nullptr);
-        if (!row.error.empty()) entry["error"] = row.error;
+        if (!row.error.empty() || !row.skipped.empty()) {
+            // No tree, so no numbers: a cost of 0 would read as the cheapest tree of all.
+            for (const char* key : {"time_ms", "candidates", "cost", "height", "relative_to_two_level"}) entry[key] = nullptr;
+            if (!row.error.empty()) entry["error"] = row.error;
+            if (!row.skipped.empty()) entry["skipped"] = row.skipped;
+        }
         out.push_back(entry);
     }
     fmt::print("{}\n", json_text(out, 2));
@@ -209,7 +218,7 @@ int run_compare(const CompareArguments& args) {
                 // Not built: its subset DP doubles per primitive (docs/solver.md §2).
                 row.algorithm = std::string(to_string(algorithm));
                 row.primitives = count;
-                row.error = fmt::format("skipped: {} primitives > {} (optimum limit)", count, optimum_limit);
+                row.skipped = fmt::format("{} primitives > {} (--optimum-max-primitives)", count, optimum_limit);
             } else {
                 row = measure(model->primitives, algorithm, settings, args.repeats);
             }
@@ -233,7 +242,9 @@ int run_compare(const CompareArguments& args) {
         print_markdown(rows);
     else
         print_text(rows);
-    return exit_ok;
+    // Every row is printed, and a failed build still fails the command.
+    const bool failed = std::any_of(rows.begin(), rows.end(), [](const Row& row) { return !row.error.empty(); });
+    return failed ? exit_bad_input : exit_ok;
 }
 }  // namespace
 
@@ -249,7 +260,8 @@ void add_compare_command(CLI::App& app, Command& command) {
         ->capture_default_str()
         ->check(whole_number(1, 1000));
     sub->add_option("--optimum-max-primitives", args->optimum_max_primitives,
-                    "Compute the optimum (gap column) for models up to this size; at most the optimal builder's limit")
+                    "Compute the optimum (gap column) for models up to this size, at most the optimal builder's "
+                    "limit; above it an `optimal` row is skipped (reported as skipped, with no numbers)")
         ->capture_default_str();
     sub->add_option("--bnb-nodes", args->bnb_nodes,
                     "Search-node budget per solver call of the survey's branch and bound (0 = library default)");
@@ -260,8 +272,9 @@ void add_compare_command(CLI::App& app, Command& command) {
         "Gap to optimum: cost / optimum - 1 (JSON: gap_to_optimum, a fraction, null when unknown), where the\n"
         "optimum is the optimal builder's proven Eq. 2 minimum; computed for models of at most\n"
         "--optimum-max-primitives primitives. Rows whose solver stopped at its budget are marked.\n"
-        "--time-limit also bounds bnb-tightest and bnb-enlarge here (spread over their solver calls); it bounds\n"
-        "solver searches, not candidate fitting, so a row can take longer. optimal and the heuristics ignore it.\n"
+        "--time-limit bounds every build, optimal's too (bnb-tightest and bnb-enlarge spread it over their solver\n"
+        "calls); an optimal build it stops proves no optimum, so that model's gaps are then unknown.\n"
+        "A row whose build fails prints its error, and compare then exits 1.\n"
         "Example: hbvh compare data/models/*.xml --markdown");
     sub->callback([&command, args] { command = [args] { return run_compare(*args); }; });
 }
