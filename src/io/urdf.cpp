@@ -313,16 +313,19 @@ private:
         const std::string name = collision.name.empty() ? fallback_name : collision.name;
         const RigidTransform world = world_from_link * to_transform(collision.origin);
         const pugi::xml_node element = site.element;
+        // Only a shape that is a single point is a placeholder (Drake's radius-0 spheres on frame-only links): a
+        // plate, a disc or a rod has no volume but real extent, and a flat or thin primitive is valid (until
+        // 2026-12-07 any zero size dropped the shape, and a 1 m plate with it).
         auto placeholder = [&](const char* what) {
-            result_.warnings.push_back(
-                source_->warning_at(element, std::string(what) + " '" + name + "' has zero size; skipped as a placeholder"));
+            result_.warnings.push_back(source_->warning_at(
+                element, std::string(what) + " '" + name + "' has zero size (a point); skipped as a placeholder"));
             return Status(Ok{});
         };
         auto negative = [&]() { return Status(source_->error_at(element, "collision '" + name + "' has a negative size")); };
         const Vec3 axis = world.rotation.col(2);
         if (site.capsule) {
             const CapsuleShape& shape = *site.capsule;
-            if (shape.radius == 0.0) return placeholder("capsule");
+            if (shape.radius == 0.0 && shape.length == 0.0) return placeholder("capsule");
             const double half = 0.5 * shape.length;
             result_.primitives.push_back(
                 {Capsule{world.translation - half * axis, world.translation + half * axis, shape.radius}, name});
@@ -341,7 +344,7 @@ private:
                 const urdf::Vector3& dim = static_cast<const urdf::Box&>(*geometry).dim;
                 const Vec3 full(dim.x, dim.y, dim.z);
                 if ((full.array() < 0.0).any()) return negative();
-                if ((full.array() == 0.0).any()) return placeholder("box");
+                if ((full.array() == 0.0).all()) return placeholder("box");
                 // URDF gives full extents; hbvh stores half extents.
                 result_.primitives.push_back({Obb{world.translation, world.rotation, 0.5 * full}, name});
                 return Ok{};
@@ -349,8 +352,15 @@ private:
             case urdf::Geometry::CYLINDER: {
                 const auto& cylinder = static_cast<const urdf::Cylinder&>(*geometry);
                 if (cylinder.radius < 0.0 || cylinder.length < 0.0) return negative();
-                if (cylinder.radius == 0.0 || cylinder.length == 0.0) return placeholder("cylinder");
-                result_.primitives.push_back({enclose_cylinder(world, cylinder.radius, 0.5 * cylinder.length), name});
+                if (cylinder.radius == 0.0 && cylinder.length == 0.0) return placeholder("cylinder");
+                const double half = 0.5 * cylinder.length;
+                if (cylinder.radius == 0.0) {  // a rod: the segment itself, a capsule of radius 0
+                    result_.primitives.push_back(
+                        {Capsule{world.translation - half * axis, world.translation + half * axis, 0.0}, name});
+                    return Ok{};
+                }
+                // A disc (length 0) comes out as a flat box: its volume 0 beats any capsule's.
+                result_.primitives.push_back({enclose_cylinder(world, cylinder.radius, half), name});
                 return Ok{};
             }
             case urdf::Geometry::MESH: {

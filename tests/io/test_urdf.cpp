@@ -79,6 +79,40 @@ TEST(Urdf, AnymalMatchesItsMjcfTwin) {
     }
 }
 
+// Only a point is a placeholder: a plate (a box with one zero size), a disc (a cylinder of length 0), a rod (a cylinder
+// of radius 0) and a segment (a capsule of radius 0) have real extent and are kept as flat or thin primitives, which
+// the library and both file formats hold. Until 2026-12-07 any zero size dropped the shape.
+TEST(Urdf, FlatAndThinShapesAreKeptAndOnlyPointsAreSkipped) {
+    const fs::path folder = fs::temp_directory_path() / "hbvh_urdf_flat";
+    fs::create_directories(folder);
+    const fs::path file = folder / "flat.urdf";
+    std::ofstream(file) << "<robot name=\"r\">\n<link name=\"base\">\n"
+                           "<collision name=\"plate\"><geometry><box size=\"1 2 0\"/></geometry></collision>\n"
+                           "<collision name=\"disc\"><origin xyz=\"3 0 0\"/><geometry><cylinder radius=\"0.5\" length=\"0\"/>"
+                           "</geometry></collision>\n"
+                           "<collision name=\"rod\"><origin xyz=\"0 3 0\"/><geometry><cylinder radius=\"0\" length=\"2\"/>"
+                           "</geometry></collision>\n"
+                           "<collision name=\"dot\"><geometry><sphere radius=\"0\"/></geometry></collision>\n"
+                           "<collision name=\"nothing\"><geometry><box size=\"0 0 0\"/></geometry></collision>\n"
+                           "</link>\n</robot>\n";
+    const Result<ImportResult> imported = import_urdf(file.string());
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    const auto& p = imported->primitives;
+    ASSERT_EQ(p.size(), 3u);
+    EXPECT_EQ(p[0].name, "plate");
+    EXPECT_EQ(test::compare_volumes(p[0].volume, Obb{Vec3::Zero(), Mat3::Identity(), Vec3(0.5, 1.0, 0.0)}, 1e-12), "");
+    EXPECT_EQ(p[1].name, "disc");
+    EXPECT_EQ(test::compare_volumes(p[1].volume, Obb{Vec3(3, 0, 0), Mat3::Identity(), Vec3(0.5, 0.5, 0.0)}, 1e-12), "");
+    EXPECT_EQ(p[2].name, "rod");
+    EXPECT_EQ(test::compare_volumes(p[2].volume, Capsule{Vec3(0, 3, -1), Vec3(0, 3, 1), 0.0}, 1e-12), "");
+    ASSERT_EQ(imported->warnings.size(), 2u);
+    EXPECT_NE(imported->warnings[0].find("flat.urdf:6: sphere 'dot' has zero size (a point)"), std::string::npos)
+        << imported->warnings[0];
+    EXPECT_NE(imported->warnings[1].find("flat.urdf:7: box 'nothing' has zero size (a point)"), std::string::npos)
+        << imported->warnings[1];
+    fs::remove_all(folder);
+}
+
 TEST(Urdf, ErrorsNameFileLineAndProblem) {
     const fs::path folder = fs::temp_directory_path() / "hbvh_urdf_errors";
     fs::create_directories(folder);
