@@ -170,7 +170,14 @@ Primitives make_boxes(const py::handle& centers_in, const py::handle& half_exten
     for (py::ssize_t i = 0; i < n; ++i) {
         const Vec3 center = vec3_at(centers, i);
         const Vec3 half = vec3_at(half_extents, i);
-        const auto rotation = [&] { return round_rotations ? float32_rotation_repaired(mat3_at(*rotations, i)) : mat3_at(*rotations, i); };
+        // A double rotation accepted within rotation_tolerance is stored as its nearest rotation too: the fitters
+        // place a box's corners with R and the exact tests map points back with R^T, which differ by the
+        // matrix's error times the box's size (4e-10 of a 1000-unit box gave pairs that depended on the tree).
+        const auto rotation = [&] {
+            const Mat3 given = mat3_at(*rotations, i);
+            if (round_rotations) return float32_rotation_repaired(given);
+            return rotation_problem(given).empty() ? exact_rotation(given) : given;
+        };
         // Without rotations a box is axis-aligned: an Aabb primitive, as in the survey's XML.
         BoundingVolume volume = rotations ? BoundingVolume(Obb{center, rotation(), half})
                                           : BoundingVolume(Aabb{center - half, center + half});

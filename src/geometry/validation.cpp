@@ -73,6 +73,12 @@ Mat3 nearest_rotation(const Mat3& m) {
     return svd.matrixU() * svd.matrixV().transpose();
 }
 
+Mat3 exact_rotation(const Mat3& rotation) {
+    constexpr double rounding_only = 2e-15;
+    if (rotation == Mat3::Identity() || measure_rotation(rotation).orthogonality <= rounding_only) return rotation;
+    return nearest_rotation(rotation);
+}
+
 std::string rotation_problem(const Mat3& rotation) {
     if (is_rotation(rotation)) return {};
     // Which condition failed, in the order of is_rotation, with its number.

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 
+#include "hbvh/geometry/validation.hpp"
 #include "pair_tests.hpp"
 #include "sort_pairs.hpp"
 #include "../simd/wide_clones.hpp"
@@ -205,10 +206,15 @@ private:
 }  // namespace
 
 RigidTransform relative_transform(const RigidTransform& pose_a, const RigidTransform& pose_b) {
+    // A pose accepted within rotation_tolerance of a rotation is read as its nearest rotation: R_a^T is the inverse
+    // below, and the traversal moves nodes both ways with R and R^T, so a rotation off by 4e-10 placed geometry 1e6
+    // from the origin 4e-4 apart from one path to the other, and trees of the same primitives gave different pairs.
+    const Mat3 rotation_a = exact_rotation(pose_a.rotation);
+    const Mat3 rotation_b = exact_rotation(pose_b.rotation);
     // R_a^T (T_b - T_a), not R_a^T T_b - R_a^T T_a: two objects kilometres from the origin but close to each
     // other then lose only the rounding of their small offset, not u x |T| of each (docs/reliability.md §5).
-    const Mat3 inverse_rotation = pose_a.rotation.transpose();
-    return {inverse_rotation * pose_b.rotation, inverse_rotation * (pose_b.translation - pose_a.translation)};
+    const Mat3 inverse_rotation = rotation_a.transpose();
+    return {inverse_rotation * rotation_b, inverse_rotation * (pose_b.translation - pose_a.translation)};
 }
 
 // Compiled for AVX2 too, with the traversal and the node tests inlined (simd/wide_clones.hpp): 10-20 % less time

@@ -147,6 +147,23 @@ def test_single_precision_rotations_are_the_nearest_rotation():
         hbvh.boxes(np.zeros((1, 3), np.float32), np.ones((1, 3)), (1.01 * rotation)[None].astype(np.float32))
 
 
+def test_double_rotations_accepted_within_tolerance_are_stored_orthonormal():
+    # diag(1 + 4e-10, 1 - 4e-10, 1) is accepted (within 1e-9), and kept as given the fitters and the exact tests read
+    # a 1000-unit box 4e-7 apart: trees of the same boxes gave different pairs (a user's review, 2026-12-07).
+    eps = 4e-10
+    kept = hbvh.boxes(np.zeros((1, 3)), np.full((1, 3), 1000.0), np.diag([1 + eps, 1 - eps, 1.0])[None])
+    rotation = kept.array["rotation"][0]
+    assert np.abs(rotation.T @ rotation - np.eye(3)).max() <= 4e-16
+    assert np.abs(rotation - np.eye(3)).max() <= 1e-15
+    # A rotation already orthonormal to rounding is kept bit for bit.
+    c, s = np.cos(0.3), np.sin(0.3)
+    exact = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1.0]])
+    assert (hbvh.boxes(np.zeros((1, 3)), np.ones((1, 3)), exact[None]).array["rotation"][0] == exact).all()
+    # One off by more than the tolerance is refused, not repaired.
+    with pytest.raises(hbvh.Error, match="rotation"):
+        hbvh.boxes(np.zeros((1, 3)), np.ones((1, 3)), np.diag([1 + 1e-6, 1.0, 1.0])[None])
+
+
 def test_type_weights_dict_entries_are_each_a_kind():
     chair = hbvh.load(str(MODELS / "chair.xml"))
     with pytest.raises(hbvh.Error, match="unknown BV type 'obb=50,sphere'"):

@@ -15,6 +15,7 @@
 #include "hbvh/builders/build.hpp"
 #include "hbvh/builders/optimal.hpp"
 #include "hbvh/geometry/overlap.hpp"
+#include "hbvh/geometry/validation.hpp"
 #include "hbvh/tree/stats.hpp"
 #include "hbvh/tree/validate.hpp"
 #include "hbvh/query/tandem_traversal.hpp"
@@ -428,6 +429,34 @@ TEST(TandemTraversal, BvhOverloadAndEmptyTrees) {
     const Bvh empty;
     EXPECT_FALSE(collide(empty, pose, bvh, pose).intersecting);
     EXPECT_FALSE(collide_two_level(bvh, pose, empty, pose).intersecting);
+}
+
+// A pose accepted within rotation_tolerance but not orthonormal to rounding is read as its nearest rotation, on every
+// path of the query. A user's construction (2026-12-07): 40 boxes sharing a face at x = 1e6 + 0.01, b's pose
+// diag(1 + 4e-10, 1 - 4e-10, 1) with translation (-1e6, 0, 0), a sphere 1e-4 beyond box 20's face under the nearest
+// rotation (the identity) and 3e-4 inside it under the matrix as given. R^T taken as the inverse moved one path's
+// geometry by 4e-4: the two-level tree reported the pair and every deeper tree did not. Now every builder's tree
+// gives what brute force gives under the nearest rotation.
+TEST(TandemTraversal, APoseNearlyARotationIsReadAsItsNearestRotation) {
+    constexpr double epsilon = 4e-10;
+    std::vector<Primitive> boxes;
+    for (int k = 0; k < 40; ++k)
+        boxes.push_back({Aabb{Vec3(1e6 - 0.01, 0.01 * k - 0.004, -0.01), Vec3(1e6 + 0.01, 0.01 * k + 0.004, 0.01)}, ""});
+    const double face = (1.0 + epsilon) * (1e6 + 0.01) - 1e6;
+    const std::vector<Primitive> sphere{{Sphere{Vec3(face + 1e-3 - 3e-4, 0.2 * (1.0 - epsilon), 0.0), 1e-3}, ""}};
+    RigidTransform pose_b{Mat3(Vec3(1.0 + epsilon, 1.0 - epsilon, 1.0).asDiagonal()), Vec3(-1e6, 0.0, 0.0)};
+    ASSERT_TRUE(validate_pose(pose_b));  // accepted, within rotation_tolerance
+    const RigidTransform nearest{nearest_rotation(pose_b.rotation), pose_b.translation};
+    ASSERT_TRUE(nearest.rotation.isApprox(Mat3::Identity(), 1e-15));
+    for (const Algorithm algorithm : {Algorithm::two_level, Algorithm::split, Algorithm::automatic, Algorithm::fast,
+                                      Algorithm::obb_tree, Algorithm::merge, Algorithm::binned}) {
+        const std::string name(to_string(algorithm));
+        const Bvh a = build(sphere, algorithm).value();
+        const Bvh b = build(boxes, algorithm).value();
+        const Pairs expected = world_brute_force(a, RigidTransform::identity(), b, nearest);
+        EXPECT_EQ(collide(a, RigidTransform::identity(), b, pose_b).pairs, expected) << name;
+        EXPECT_EQ(collide_two_level(a, RigidTransform::identity(), b, pose_b).pairs, expected) << name;
+    }
 }
 
 TEST(QueryTreeValidate, AgreesWithTheBvhsValidateWordForWord) {

@@ -24,6 +24,11 @@ inline constexpr double rotation_tolerance = 1e-9;
 /// the SVD m = U S V^T). For a matrix meant as a rotation but rounded (a file's few digits, float32): with
 /// det(m) > 0 and S near 1, U V^T is a proper rotation. Callers decide first how far from one `m` may be.
 [[nodiscard]] Mat3 nearest_rotation(const Mat3& m);
+/// `rotation` itself when it is orthonormal to a few units in the last place (|R^T R - I| <= 2e-15, what a
+/// normalised quaternion's matrix or a few products of rotations give), else nearest_rotation(rotation). For a
+/// rotation accepted within rotation_tolerance: R^T is then its inverse to rounding, so that code moving points
+/// with R and back with R^T stays consistent (a 4e-10 error moved geometry 1e6 from the origin by 4e-4).
+[[nodiscard]] Mat3 exact_rotation(const Mat3& rotation);
 /// Empty when `volume` is usable geometry; otherwise the problem in words ("radius -1 is negative", ...).
 /// Refused: non-finite numbers (also derived ones: a box's extent, a capsule's length), sizes < 0 and
 /// subnormal sizes (they vanish in the first product), rotations that are no proper rotation.
