@@ -85,6 +85,11 @@ hbvh_cli_test(overflowing_root.collide 1 "overflowing_root.xml:2: volume \\(sphe
               collide ${HBVH_CLI_INPUTS}/overflowing_root.xml ${HBVH_CLI_INPUTS}/overflowing_root.xml)
 hbvh_cli_test(overflowing_weights.stats 1 "huge_spheres.xml: the cost overflows double precision: --type-weight"
               stats ${HBVH_CLI_INPUTS}/huge_spheres.xml --type-weight aabb=1e6,obb=1e6,sphere=1e6,capsule=1e6)
+# An input format no reader has is a usage error in every command that reads (it was exit 1, as the file's problem).
+hbvh_cli_test(unknown_input_format.stats 2 "--format: unknown input format 'foo'" stats
+              ${PROJECT_SOURCE_DIR}/data/models/chair.xml --format foo)
+hbvh_cli_test(unknown_input_format.export 2 "--input-format: unknown input format 'foo'" export
+              ${PROJECT_SOURCE_DIR}/data/models/chair.xml -o ${HBVH_CLI_OUT}/unknown_format.dot --input-format foo)
 hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-not-exist.xml -o ${HBVH_CLI_OUT}/x.xml)
 # A directory whose name looks like a model is refused as a directory, not by its extension.
 file(MAKE_DIRECTORY ${HBVH_CLI_OUT}/a_directory.xml)

@@ -123,7 +123,8 @@ void add_build_command(CLI::App& app, Command& command) {
     sub->add_option("-o,--output", args->output, "Output hierarchy (survey XML; .hbvh: binary), or - for stdout")
         ->capture_default_str()
         ->check(hierarchy_output_name());
-    sub->add_option("--format", args->format, "Input format when the extension does not tell");
+    sub->add_option("--format", args->format, "Input format when the extension does not tell")
+        ->check(input_format());
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
     sub->add_flag("--report", args->report,

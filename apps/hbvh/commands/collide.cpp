@@ -113,7 +113,8 @@ void add_collide_command(CLI::App& app, Command& command) {
     CLI::App* sub = app.add_subcommand("collide", "Test two posed objects for contact (tandem traversal)");
     sub->add_option("a", args->input_a, "First object: a hierarchy or a primitive set")->required();
     sub->add_option("b", args->input_b, "Second object")->required();
-    sub->add_option("--format", args->format, "Input format of both objects when their extensions do not tell");
+    sub->add_option("--format", args->format, "Input format of both objects when their extensions do not tell")
+        ->check(input_format());
     sub->add_option("--pose-a", args->pose_a, "Pose of a: \"tx ty tz [qw qx qy qz]\" (default identity)");
     sub->add_option("--pose-b", args->pose_b, "Pose of b (default identity)");
     args->builder.add_to(*sub);

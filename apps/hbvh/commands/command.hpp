@@ -62,6 +62,9 @@ void report_warnings(const std::vector<std::string>& warnings);
 [[nodiscard]] CLI::Validator hierarchy_output_name();
 /// Refuses an empty output name (a usage error, exit 2).
 [[nodiscard]] CLI::Validator output_name();
+/// Refuses an input --format that no reader has (a usage error, exit 2, before any file is read; it was exit 1,
+/// worded as a problem of the input file).
+[[nodiscard]] CLI::Validator input_format();
 
 /// A builder and what steers it, as the flags chose: the deadline starts when run() does.
 struct BuildRequest {

@@ -22,7 +22,8 @@ void add_convert_command(CLI::App& app, Command& command) {
     sub->add_option("-o,--output", args->output, "Output survey XML (.hbvh: binary), or - for stdout")
         ->capture_default_str()
         ->check(hierarchy_output_name());
-    sub->add_option("--format", args->format, "hbvh, xml, mjcf, urdf or mesh, when the extension does not tell; mesh-nodes: a plain mesh, one fitted primitive per mesh node");
+    sub->add_option("--format", args->format, "hbvh, xml, mjcf, urdf or mesh, when the extension does not tell; mesh-nodes: a plain mesh, one fitted primitive per mesh node")
+        ->check(input_format());
     args->checks.add_refit_to(*sub);
     sub->footer("Example: hbvh convert robot.urdf -o robot.xml");
     sub->callback([&command, args] {

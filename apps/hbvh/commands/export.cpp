@@ -143,7 +143,8 @@ void add_export_command(CLI::App& app, Command& command) {
         ->check(output_name());
     sub->add_option("--format", args->format, "gltf, dot or svg, when the output's extension does not tell")
         ->check(CLI::IsMember({"gltf", "dot", "svg"}));
-    sub->add_option("--input-format", args->input_format, "Input format when the extension does not tell");
+    sub->add_option("--input-format", args->input_format, "Input format when the extension does not tell")
+        ->check(input_format());
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
     sub->add_flag("--overlay", args->overlay, "glTF: put all levels at the same place instead of side by side");

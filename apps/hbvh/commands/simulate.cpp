@@ -74,7 +74,8 @@ void add_simulate_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<SimulateArguments>();
     CLI::App* sub = app.add_subcommand("simulate", "The survey's collision benchmark (§5.3, Table 4) on two copies of an object");
     sub->add_option("file", args->input, "A hierarchy or a primitive set")->required();
-    sub->add_option("--format", args->format, "Input format when the extension does not tell");
+    sub->add_option("--format", args->format, "Input format when the extension does not tell")
+        ->check(input_format());
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
     sub->add_option("--collisions", args->options.collision_count, "Root-overlapping queries to measure")

@@ -118,7 +118,8 @@ void add_stats_command(CLI::App& app, Command& command) {
     auto args = std::make_shared<StatsArguments>();
     CLI::App* sub = app.add_subcommand("stats", "Quality measures of a hierarchy (cost Eq. 2, tightness Eq. 1, shape)");
     sub->add_option("file", args->input, "Hierarchy file, or a primitive set (built first with -a)")->required();
-    sub->add_option("--format", args->format, "Input format when the extension does not tell");
+    sub->add_option("--format", args->format, "Input format when the extension does not tell")
+        ->check(input_format());
     args->builder.add_to(*sub);
     sub->add_flag("--json", args->json, "Print JSON with the keys listed in docs/metrics.md");
     sub->footer("Example: hbvh stats chair.hbvh.xml --json");

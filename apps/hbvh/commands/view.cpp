@@ -52,7 +52,8 @@ void add_view_command(CLI::App& app, Command& command) {
     sub->add_option("-o,--output", args->output, "Output HTML page, or - for stdout")
         ->capture_default_str()
         ->check(output_name());
-    sub->add_option("--format", args->format, "Input format when the extension does not tell");
+    sub->add_option("--format", args->format, "Input format when the extension does not tell")
+        ->check(input_format());
     sub->add_option("--title", args->title, "Page title (default: the input's file name)");
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
