@@ -18,6 +18,7 @@ public:
         sum_ += value;
         ++count_;
     }
+    [[nodiscard]] bool empty() const { return count_ == 0; }
     [[nodiscard]] Summary summary() const {
         if (count_ == 0) return {};
         return {min_, sum_ / static_cast<double>(count_), max_};
@@ -84,10 +85,21 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
         }
         // Sibling overlap: pairwise intersection of the children's world AABBs (docs/metrics.md).
         overlap_volume += detail::pairwise_intersection_volume(child_boxes);
-        if (children_volume > 0.0) tightness.add(volume(node.volume) / children_volume);
+        // Eq. 1 as it stands: a node with volume over children without any (flat boxes, points) is infinitely
+        // loose, not left out (until 2026-12-07 such nodes were dropped, and a tree of only them read 0, "perfectly
+        // tight"). A node without volume over children without volume has no ratio at all.
+        const double own_volume = volume(node.volume);
+        if (children_volume > 0.0)
+            tightness.add(own_volume / children_volume);
+        else if (own_volume > 0.0)
+            tightness.add(std::numeric_limits<double>::infinity());
     }
     stats.branching = branching.summary();
     stats.tightness = tightness.summary();
+    // Inner nodes, yet not one ratio (every volume 0): undefined, not 0.
+    if (stats.inner_nodes > 0 && stats.tightness.min == 0.0 && stats.tightness.max == 0.0 && tightness.empty())
+        stats.tightness = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
+                           std::numeric_limits<double>::quiet_NaN()};
     stats.leaf_depth = leaf_depth.summary();
     stats.overlap = sibling_volume > 0.0 ? overlap_volume / sibling_volume : 0.0;
     return stats;

@@ -2,6 +2,9 @@
 // TreeAssembler layout, level views, validate() and the survey's cost on hand-computed examples.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -155,6 +158,27 @@ TEST(Stats, CostIsChildrenTimesVolumeSummedOverInnerNodes) {
     EXPECT_DOUBLE_EQ(stats.leaf_depth.mean, 2.0);
     EXPECT_DOUBLE_EQ(stats.overlap, 0.0);  // siblings are disjoint (they touch nowhere)
     EXPECT_EQ(stats.types[0], 7u);
+}
+
+// Eq. 1 over children without volume: a box over two flat plates is infinitely loose (such nodes were left out, and
+// a tree of only them read 0, "perfectly tight"); a tree whose every volume is 0 has no ratio at all (NaN).
+TEST(Stats, TightnessOverChildrenWithoutVolumeIsInfiniteOrUndefined) {
+    const std::vector<Primitive> plates{{Aabb{Vec3(0, 0, 0), Vec3(1, 1, 0)}, ""}, {Aabb{Vec3(0, 0, 1), Vec3(1, 1, 1)}, ""}};
+    TreeAssembler over_plates(plates);
+    const std::uint32_t plate_leaves[] = {over_plates.add_leaf(0), over_plates.add_leaf(1)};
+    const Stats loose = compute_stats(std::move(over_plates).finish(
+        over_plates.add_group(plate_leaves, Aabb{Vec3(0, 0, 0), Vec3(1, 1, 1)})));
+    EXPECT_EQ(loose.tightness.min, std::numeric_limits<double>::infinity());
+    EXPECT_EQ(loose.tightness.max, std::numeric_limits<double>::infinity());
+    // With a finite ratio beside it, the finite one is the minimum.
+    const Stats mixed = compute_stats(two_pairs());
+    EXPECT_TRUE(std::isfinite(mixed.tightness.max));
+    const std::vector<Primitive> lines{{Aabb{Vec3(0, 0, 0), Vec3(1, 0, 0)}, ""}, {Aabb{Vec3(2, 0, 0), Vec3(3, 0, 0)}, ""}};
+    TreeAssembler over_lines(lines);
+    const std::uint32_t line_leaves[] = {over_lines.add_leaf(0), over_lines.add_leaf(1)};
+    const Stats flat = compute_stats(std::move(over_lines).finish(
+        over_lines.add_group(line_leaves, Aabb{Vec3(0, 0, 0), Vec3(3, 0, 0)})));
+    EXPECT_TRUE(std::isnan(flat.tightness.min) && std::isnan(flat.tightness.mean) && std::isnan(flat.tightness.max));
 }
 
 TEST(Stats, WeightsScaleEachTypesVolume) {

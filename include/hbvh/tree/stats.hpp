@@ -28,7 +28,8 @@ struct Stats {
     std::uint32_t inner_nodes = 0;
     std::uint32_t leaves = 0;
     Summary branching;               ///< Children per inner node.
-    Summary tightness;               ///< Eq. 1 per inner node: volume / sum of children's volumes.
+    Summary tightness;               ///< Eq. 1 per inner node: volume / sum of children's volumes; +inf for a node
+                                     ///< with volume over children without any, NaN when no inner node has a ratio.
     Summary leaf_depth;              ///< Depth of each leaf (balance).
     double overlap = 0.0;            ///< See docs/metrics.md: sibling AABB overlap relative to sibling volume.
     std::array<std::uint32_t, bv_type_count> types{};  ///< Node count per BV kind (all nodes).
