@@ -90,6 +90,9 @@ hbvh_cli_test(unknown_input_format.stats 2 "--format: unknown input format 'foo'
               ${PROJECT_SOURCE_DIR}/data/models/chair.xml --format foo)
 hbvh_cli_test(unknown_input_format.export 2 "--input-format: unknown input format 'foo'" export
               ${PROJECT_SOURCE_DIR}/data/models/chair.xml -o ${HBVH_CLI_OUT}/unknown_format.dot --input-format foo)
+# A folder that takes no new file even for root (access() says it does) is refused before the measuring.
+hbvh_cli_test(calibrate_into_proc 1 "/proc/w.txt: cannot write: the folder /proc does not take new files"
+              calibrate -o /proc/w.txt)
 hbvh_cli_test(missing_file 1 "does-not-exist.xml" build ${HBVH_CLI_INPUTS}/does-not-exist.xml -o ${HBVH_CLI_OUT}/x.xml)
 # A directory whose name looks like a model is refused as a directory, not by its extension.
 file(MAKE_DIRECTORY ${HBVH_CLI_OUT}/a_directory.xml)

@@ -12,6 +12,8 @@
 // kind alike instead (the row's mean) ranked the trees of generated objects worse and made their calibrated
 // trees slower (docs/metrics.md, "Per-kind weights"), so the table of pairs is written for the record only.
 #include <fmt/core.h>
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -91,13 +93,23 @@ int run_calibrate(const CalibrateArguments& args) {
         std::error_code ignored;
         if (!std::filesystem::is_directory(folder, ignored))
             return report_error(Error{"cannot write: the folder " + folder.string() + " does not exist", args.output});
-        // The output is written next to itself and renamed, so the folder must take a new file.
-        if (::access(folder.c_str(), W_OK | X_OK) != 0)
-            return report_error(Error{"cannot write: the folder " + folder.string() + " does not take new files (" +
-                                          std::strerror(errno) + ")",
-                                      args.output});
         if (std::filesystem::is_directory(output, ignored))
             return report_error(Error{"is a directory, not a file: give the output a file name", args.output});
+        // The output is written next to itself and renamed, so the folder must take a new file: tried with one, since
+        // access() says yes to root in folders that take none (/sys, /proc, a read-only mount). A device or fifo is
+        // written into instead (write_file_atomic), which needs no new file.
+        struct stat existing {};
+        const bool stream = ::stat(output.c_str(), &existing) == 0 && !S_ISREG(existing.st_mode);
+        if (!stream) {
+            const std::filesystem::path probe = folder / (".hbvh-calibrate-probe-" + std::to_string(::getpid()));
+            const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+            if (fd < 0)
+                return report_error(Error{"cannot write: the folder " + folder.string() + " does not take new files (" +
+                                              std::strerror(errno) + ")",
+                                          args.output});
+            ::close(fd);
+            ::unlink(probe.c_str());
+        }
     }
     const std::vector<Primitive> scene = generate_scene({.count = args.primitives, .seed = 11});
     const Result<Bvh> flat = build(scene, Algorithm::two_level);
