@@ -32,7 +32,8 @@ struct CollideResult {
     std::vector<std::pair<std::uint32_t, std::uint32_t>> pairs;
     std::uint64_t bv_tests = 0;         ///< Overlap tests in which at least one volume is an inner node's.
     std::uint64_t primitive_tests = 0;  ///< Overlap tests between two leaves (exact primitive geometry).
-    std::uint64_t nodes_visited = 0;    ///< Node pairs that passed the (conservative) inner test, then expanded or reported.
+    std::uint64_t nodes_visited = 0;    ///< Node pairs that passed the conservative inner test, then were expanded
+                                        ///< or reported.
     /// Set when the query was refused (a pose that is no rigid motion, or for the Bvh overloads a hierarchy
     /// that fails check_structure()); the rest of the result is then empty. Poses made by
     /// RigidTransform::from_quaternion from a non-zero quaternion are never refused.
