@@ -56,7 +56,8 @@ std::string export_dot(const Bvh& bvh, const DotOptions& options) {
     const auto height = static_cast<std::uint32_t>(views.size() - 1);
     const Stats stats = compute_stats(bvh);
     out += "  graph [rankdir=TB, ranksep=0.35, nodesep=0.12, fontname=\"Helvetica\", fontsize=12, labelloc=t, label=\"" +
-           escape(std::to_string(stats.nodes) + " nodes (" + std::to_string(stats.leaves) + " primitives), height " +
+           escape(std::to_string(stats.nodes) + (stats.nodes == 1 ? " node (" : " nodes (") + std::to_string(stats.leaves) +
+                  (stats.leaves == 1 ? " primitive), height " : " primitives), height ") +
                   std::to_string(stats.height) + ", cost " + format_number(stats.cost)) +
            "\"];\n";
     out += "  node [shape=box, style=\"rounded,filled\", fontname=\"Helvetica\", fontsize=9, margin=\"0.06,0.03\"];\n";

@@ -101,8 +101,9 @@ int run_build(const BuildArguments& args) {
         const Stats stats = compute_stats(bvh.value(), policy);
         if (args.report) print_report(report, seconds, stats.cost);
         if (args.stats)
-            fmt::print(stderr, "{}: {} primitives, {} nodes, height {}, cost {:.6g} ({} in {:.3f} ms); {}\n", args.input,
-                       stats.leaves, stats.nodes, stats.height, stats.cost,
+            fmt::print(stderr, "{}: {}, {}, height {}, cost {:.6g} ({} in {:.3f} ms); {}\n", args.input,
+                       counted(stats.leaves, "primitive", "primitives"), counted(stats.nodes, "node", "nodes"),
+                       stats.height, stats.cost,
                        report.built_by.empty() ? std::string(to_string(algorithm))
                                                : std::string(to_string(algorithm)) + ", built by " + report.built_by,
                        1e3 * seconds,

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+#include <cstdint>
 #include <functional>
 #include <optional>
 #include <string>
@@ -60,6 +61,11 @@ void report_warnings(const std::vector<std::string>& warnings);
 /// Refuses an output name whose extension is another format's (.gltf, .obj, .dot, .html, .urdf, ...) for the
 /// commands that write survey XML or, for .hbvh, the binary format: XML written into x.gltf was read as glTF later.
 [[nodiscard]] CLI::Validator hierarchy_output_name();
+/// "1 leaf", "2 leaves": a count with its noun in the right number.
+[[nodiscard]] inline std::string counted(std::uint64_t count, std::string_view singular, std::string_view plural) {
+    return std::to_string(count) + " " + std::string(count == 1 ? singular : plural);
+}
+
 /// Refuses an empty output name (a usage error, exit 2).
 [[nodiscard]] CLI::Validator output_name();
 /// Refuses an input --format that no reader has (a usage error, exit 2, before any file is read; it was exit 1,

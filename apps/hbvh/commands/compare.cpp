@@ -209,7 +209,7 @@ int run_compare(const CompareArguments& args) {
         report_warnings(model->warnings);
         const std::size_t count = model->primitives.size();
         const std::string name = std::filesystem::path(input).stem().string();
-        fmt::print(stderr, "hbvh compare: {} ({} primitives)\n", name, count);
+        fmt::print(stderr, "hbvh compare: {} ({})\n", name, counted(count, "primitive", "primitives"));
         const double baseline = measure(model->primitives, Algorithm::two_level, settings, 1).cost;
         const std::size_t first = rows.size();
         for (Algorithm algorithm : chosen) {

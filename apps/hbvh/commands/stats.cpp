@@ -46,7 +46,7 @@ void print_text(const Stats& stats) {
     fmt::print("{:<12} {:.6g}\n", "cost", stats.cost);
     fmt::print("{:<12} {:.6g}\n", "calibrated", stats.calibrated_cost);
     fmt::print("{:<12} {}\n", "height", stats.height);
-    fmt::print("{:<12} {} ({} inner, {} leaves)\n", "nodes", stats.nodes, stats.inner_nodes, stats.leaves);
+    fmt::print("{:<12} {} ({} inner, {})\n", "nodes", stats.nodes, stats.inner_nodes, counted(stats.leaves, "leaf", "leaves"));
     line("branching", stats.branching);
     line("tightness", stats.tightness);
     line("leaf depth", stats.leaf_depth);
