@@ -130,16 +130,26 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const
     return row;
 }
 
+/// `text` for a Markdown table cell: a '|' would end the cell.
+std::string markdown_cell(const std::string& text) {
+    std::string out;
+    for (const char c : text) {
+        if (c == '|') out += '\\';
+        out += c;
+    }
+    return out;
+}
+
 void print_markdown(const std::vector<Row>& rows) {
     fmt::print("| model | algorithm | primitives | time (ms) | MC | cost | height | cost / two-level | gap to optimum |\n");
     fmt::print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for (const Row& row : rows) {
         if (!row.error.empty() || !row.skipped.empty()) {
-            fmt::print("| {} | {} | {} | {} | | | | | |\n", row.model, row.algorithm, row.primitives,
+            fmt::print("| {} | {} | {} | {} | | | | | |\n", markdown_cell(row.model), row.algorithm, row.primitives,
                        row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error);
             continue;
         }
-        fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", row.model, row.algorithm,
+        fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", markdown_cell(row.model), row.algorithm,
                    row.primitives, row.median_ms, row.budget_hit ? " (budget hit)" : "", row.candidates, row.cost,
                    row.height, row.relative, format_gap(row.gap));
     }
@@ -208,7 +218,12 @@ int run_compare(const CompareArguments& args) {
         if (!model) return report_error(model.error());
         report_warnings(model->warnings);
         const std::size_t count = model->primitives.size();
-        const std::string name = std::filesystem::path(input).stem().string();
+        // The file's stem, unless another input has the same one (d1/m.xml, d2/m.xml): then the path as given.
+        const std::string stem = std::filesystem::path(input).stem().string();
+        const bool shared_stem = std::count_if(args.inputs.begin(), args.inputs.end(), [&](const std::string& other) {
+                                     return std::filesystem::path(other).stem().string() == stem;
+                                 }) > 1;
+        const std::string name = shared_stem ? input : stem;
         fmt::print(stderr, "hbvh compare: {} ({})\n", name, counted(count, "primitive", "primitives"));
         const double baseline = measure(model->primitives, Algorithm::two_level, settings, 1).cost;
         const std::size_t first = rows.size();
