@@ -82,7 +82,7 @@ def span(values, fmt='{:.1f}'):
     return fmt.format(lo) if lo == hi else (fmt.format(lo) + '–' + fmt.format(hi))
 
 def compare_summary(path, label):
-    rows = [r for r in markdown_rows(path) if not r['time (ms)'].startswith('error')]
+    rows = [r for r in markdown_rows(path) if not r['time (ms)'].startswith(('error', 'skipped'))]
     models = list(dict.fromkeys(r['model'] for r in rows))
     by = {(r['model'], r['algorithm']): r for r in rows}
     gap = lambda r: number(r['gap to optimum']) if r['gap to optimum'] != '-' else None
@@ -129,7 +129,7 @@ def compare_summary(path, label):
     print(' '.join(out))
 
 def scale_summary(path):
-    rows = [r for r in markdown_rows(path) if not r['time (ms)'].startswith('error')]
+    rows = [r for r in markdown_rows(path) if not r['time (ms)'].startswith(('error', 'skipped'))]
     out, losses = [], []
     for m in dict.fromkeys(r['model'] for r in rows):
         by = {r['algorithm']: r for r in rows if r['model'] == m}
