@@ -36,7 +36,18 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-[[noreturn]] void raise(const Error& error) { throw BindingError(error.to_string()); }
+/// `text` as a Python str, each byte that starts no UTF-8 character as U+FFFD: names and paths come from files and
+/// may be Latin-1, and pybind11's strict decoding made them an empty hbvh.Error message or a UnicodeDecodeError.
+py::str text_of(const std::string& text) {
+    PyObject* decoded = PyUnicode_DecodeUTF8(text.data(), static_cast<Py_ssize_t>(text.size()), "replace");
+    if (decoded == nullptr) throw py::error_already_set();
+    return py::reinterpret_steal<py::str>(decoded);
+}
+
+/// `text` with each byte that starts no UTF-8 character replaced by U+FFFD, as UTF-8 again.
+std::string valid_utf8(const std::string& text) { return text_of(text).cast<std::string>(); }
+
+[[noreturn]] void raise(const Error& error) { throw BindingError(valid_utf8(error.to_string())); }
 
 /// A primitive set as Python sees it: a list of primitives, plus the importer's notes about skipped input.
 struct Primitives {
@@ -350,6 +361,10 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
 /// Paths are str or os.PathLike (pathlib.Path), as open() takes them.
 py::object load(const std::filesystem::path& file, const std::string& format, bool refit) {
     const std::string path = file.string();
+    // The argument's own error, before the file is opened (the CLI's --format is a usage error too).
+    static constexpr std::string_view known_formats[] = {"", "hbvh", "xml", "mjcf", "urdf", "mesh", "mesh-nodes"};
+    if (std::find(std::begin(known_formats), std::end(known_formats), format) == std::end(known_formats))
+        raise(Error{"format: unknown input format '" + format + "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)"});
     Result<ModelFile> read = read_model_file(path, format);
     if (!read) raise(read.error());
     // The checks of the CLI's load_model, then the containment check every CLI command but stats makes.
@@ -423,8 +438,15 @@ Hierarchy build_hierarchy(const py::handle& primitives_in, const std::string& al
         throw py::error_already_set();  // the warning was turned into an error (warnings filter "error")
     // A build stopped by time_limit returns a tree all the same (the best so far, or the two-level one): say so,
     // as the CLI's --stats does, with the builder's own notes.
-    if (!report.time_limit.empty() &&
-        PyErr_WarnEx(PyExc_UserWarning, ("time_limit reached: " + report.time_limit).c_str(), 1) != 0)
+    // Some builders note the stop only among their notes (scale, the treelets), so budget_hit under a time limit
+    // warns too, with those notes.
+    std::string stopped = report.time_limit;
+    if (stopped.empty() && report.budget_hit && time_limit > 0.0) {
+        for (const std::string& note : report.notes)
+            if (note.find("time limit") != std::string::npos) stopped += (stopped.empty() ? "" : "; ") + note;
+        if (stopped.empty()) stopped = "the build stopped at its budget";
+    }
+    if (!stopped.empty() && PyErr_WarnEx(PyExc_UserWarning, valid_utf8("time_limit reached: " + stopped).c_str(), 1) != 0)
         throw py::error_already_set();
     return Hierarchy::from(std::move(built->value()));
 }
@@ -521,11 +543,15 @@ PYBIND11_MODULE(hbvh, m) {
                                "Structured array: type (0 aabb, 1 obb, 2 sphere, 3 capsule), center, rotation "
                                "(3x3, axes as columns), half_extents, radius, p0, p1.")
         .def_property_readonly("names", [](const Primitives& p) {
-            std::vector<std::string> names;
-            for (const auto& item : p.items) names.push_back(item.name);
+            py::list names;
+            for (const auto& item : p.items) names.append(text_of(item.name));
             return names;
         })
-        .def_readonly("warnings", &Primitives::warnings, "What the importer skipped, one line each.")
+        .def_property_readonly("warnings", [](const Primitives& p) {
+            py::list warnings;
+            for (const std::string& warning : p.warnings) warnings.append(text_of(warning));
+            return warnings;
+        }, "What the importer skipped, one line each.")
         .def("__repr__", [](const Primitives& p) { return "<hbvh.Primitives of " + std::to_string(p.items.size()) + ">"; });
 
     py::class_<Hierarchy>(m, "Hierarchy", "A bounding volume hierarchy with its query layout.")
