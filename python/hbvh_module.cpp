@@ -397,8 +397,15 @@ Result<VolumePolicy> with_type_weights(const py::object& weights, VolumePolicy p
             const std::string name = kind.cast<std::string>();
             if (name.find_first_of("=,@ \t\n") != std::string::npos)
                 return Error{"unknown BV type '" + name + "' in type_weights (aabb, obb, sphere or capsule)"};
-            Result<VolumePolicy> one = parse_type_weights(
-                name + "=" + py::repr(py::float_(py::reinterpret_borrow<py::object>(weight))).cast<std::string>(), policy);
+            // float() of a str or None raised a bare "could not convert string to float" naming neither.
+            double value = 0.0;
+            try {
+                value = py::float_(py::reinterpret_borrow<py::object>(weight)).cast<double>();
+            } catch (const py::error_already_set&) {
+                throw py::type_error("type_weights['" + name + "'] must be a number, got " +
+                                     py::repr(py::reinterpret_borrow<py::object>(weight)).cast<std::string>());
+            }
+            Result<VolumePolicy> one = parse_type_weights(name + "=" + py::repr(py::float_(value)).cast<std::string>(), policy);
             if (!one) return one;
             policy = one.value();
         }

@@ -90,7 +90,8 @@ Status check_finite_extent(std::span<const Primitive> primitives) {
         // Eigen's cwiseMin/cwiseMax may skip a NaN operand, so a NaN box would vanish from the merge.
         const Aabb own = world_aabb(primitives[i].volume);
         if (!own.min.allFinite() || !own.max.allFinite())
-            return Error{primitive_label(primitives, i) + " has non-finite coordinates", "", 0};
+            return Error{primitive_label(primitives, i) + " reaches beyond the range of double (its bounding box is "
+                         "not finite); scale the model down", "", 0};
         for (int axis = 0; axis < 3; ++axis) {
             if (own.min[axis] < box.min[axis]) lowest[static_cast<std::size_t>(axis)] = i;
             if (own.max[axis] > box.max[axis]) highest[static_cast<std::size_t>(axis)] = i;

@@ -44,7 +44,16 @@ TEST(InputRange, TheMessageNamesThePrimitivesThatSetTheWidestExtent) {
     primitives[31].volume = Sphere{Vec3(0, std::numeric_limits<double>::infinity(), 0), 1.0};
     const Status infinite = check_finite_extent(primitives);
     ASSERT_FALSE(infinite.has_value());
-    EXPECT_EQ(infinite.error().message, "primitive 31 ('stray') has non-finite coordinates");
+    EXPECT_EQ(infinite.error().message,
+              "primitive 31 ('stray') reaches beyond the range of double (its bounding box is not finite); scale the "
+              "model down");
+    // Finite numbers whose box is not: a sphere of radius 1e308 at x = 1e308 (reported as "non-finite coordinates"
+    // until 2026-12-07, which its numbers are not).
+    primitives[31].volume = Sphere{Vec3(1e308, 0, 0), 1e308};
+    const Status beyond = check_finite_extent(primitives);
+    ASSERT_FALSE(beyond.has_value());
+    EXPECT_NE(beyond.error().message.find("primitive 31 ('stray') reaches beyond the range of double"), std::string::npos)
+        << beyond.error().message;
 }
 
 TEST(InputRange, UnderflowIsRefusedButAFlatModelIsNot) {

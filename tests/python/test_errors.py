@@ -204,3 +204,11 @@ def test_names_and_messages_that_are_no_utf8_are_strings(tmp_path):
 def test_an_unknown_format_names_the_argument_before_the_file():
     with pytest.raises(hbvh.Error, match="^format: unknown input format 'obj'"):
         hbvh.load("no_such.xml", format="obj")
+
+
+def test_a_type_weight_that_is_no_number_names_its_entry():
+    # float() of it raised "could not convert string to float: 'x'", naming neither the argument nor the kind.
+    pair = hbvh.spheres([[0, 0, 0], [3, 0, 0]], [1.0, 1.0])
+    for weight in ["x", None]:
+        with pytest.raises(TypeError, match=r"type_weights\['obb'\] must be a number"):
+            hbvh.build(pair, type_weights={"obb": weight})
