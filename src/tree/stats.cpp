@@ -97,7 +97,7 @@ Stats compute_stats(const Bvh& bvh, const VolumePolicy& policy) {
     stats.branching = branching.summary();
     stats.tightness = tightness.summary();
     // Inner nodes, yet not one ratio (every volume 0): undefined, not 0.
-    if (stats.inner_nodes > 0 && stats.tightness.min == 0.0 && stats.tightness.max == 0.0 && tightness.empty())
+    if (stats.inner_nodes > 0 && tightness.empty())
         stats.tightness = {std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::quiet_NaN(),
                            std::numeric_limits<double>::quiet_NaN()};
     stats.leaf_depth = leaf_depth.summary();
