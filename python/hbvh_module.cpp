@@ -362,9 +362,7 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
 py::object load(const std::filesystem::path& file, const std::string& format, bool refit) {
     const std::string path = file.string();
     // The argument's own error, before the file is opened (the CLI's --format is a usage error too).
-    static constexpr std::string_view known_formats[] = {"", "hbvh", "xml", "mjcf", "urdf", "mesh", "mesh-nodes"};
-    if (std::find(std::begin(known_formats), std::end(known_formats), format) == std::end(known_formats))
-        raise(Error{"format: unknown input format '" + format + "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)"});
+    if (std::string problem = input_format_problem(format); !problem.empty()) raise(Error{"format: " + problem});
     Result<ModelFile> read = read_model_file(path, format);
     if (!read) raise(read.error());
     // The checks of the CLI's load_model, then the containment check every CLI command but stats makes.

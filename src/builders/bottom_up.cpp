@@ -270,7 +270,6 @@ Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& p
         }
         level.stop_fitting_after(std::chrono::steady_clock::time_point::max());
 
-
         // Each chosen group becomes a node of the next level, with the BV already fitted for its cost.
         std::vector<LevelNode> next;
         std::vector<std::uint32_t> next_ids;

@@ -107,6 +107,12 @@ Result<ModelFile> from_import(Result<ImportResult> imported, const std::string& 
 
 }  // namespace
 
+std::string input_format_problem(std::string_view format) {
+    static constexpr std::string_view known[] = {"", "hbvh", "xml", "mjcf", "urdf", "mesh", "mesh-nodes"};
+    if (std::find(std::begin(known), std::end(known), format) != std::end(known)) return {};
+    return "unknown input format '" + std::string(format) + "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)";
+}
+
 Result<ModelFile> read_model_file(const std::string& path, std::string_view format) {
     // Before any guess from the extension: a directory named "scene.xml" is still a directory.
     std::error_code ignored;
@@ -125,10 +131,7 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         {"urdf", ImportFormat::urdf},  {"mesh", ImportFormat::mesh}};
     const auto chosen = std::find_if(std::begin(formats), std::end(formats),
                                      [&](const auto& entry) { return format == entry.first; });
-    if (chosen == std::end(formats))
-        return Error{"unknown input format '" + std::string(format) +
-                         "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)",
-                     path};
+    if (chosen == std::end(formats)) return Error{input_format_problem(format), path};
 
     const bool automatic = chosen->second == ImportFormat::automatic;
     const std::string extension = lower_case_extension(path);

@@ -85,13 +85,7 @@ CLI::Validator output_name() {
 }
 
 CLI::Validator input_format() {
-    return CLI::Validator(
-        [](const std::string& name) {
-            static constexpr std::string_view known[] = {"", "hbvh", "xml", "mjcf", "urdf", "mesh", "mesh-nodes"};  // "": by extension
-            if (std::find(std::begin(known), std::end(known), name) != std::end(known)) return std::string();
-            return "unknown input format '" + name + "' (expected hbvh, xml, mjcf, urdf, mesh or mesh-nodes)";
-        },
-        "FORMAT");
+    return CLI::Validator([](const std::string& name) { return input_format_problem(name); }, "FORMAT");
 }
 
 CLI::Validator hierarchy_output_name() {

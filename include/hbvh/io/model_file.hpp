@@ -39,6 +39,9 @@ struct ModelFile {
 /// no primitive (with the first three candidates the importer skipped, and why). Nothing is checked across
 /// primitives or nodes: validate_primitives, check_structure and containment_violations are the caller's.
 [[nodiscard]] Result<ModelFile> read_model_file(const std::string& path, std::string_view format = {});
+/// Empty when read_model_file reads `format` ("" for by extension, hbvh, xml, mjcf, urdf, mesh, mesh-nodes);
+/// otherwise "unknown input format '...' (expected ...)", for callers that check the argument before any file.
+[[nodiscard]] std::string input_format_problem(std::string_view format);
 
 /// The checks to make on what read_model_file returns before using it, as the CLI and the Python module make them:
 /// the primitives (validate_primitives, check_finite_extent) and a stored hierarchy's structure
