@@ -130,6 +130,9 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const
     return row;
 }
 
+/// What a row without a tree prints in place of its numbers: "error: ..." or "skipped: ...".
+std::string why_no_numbers(const Row& row) { return row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error; }
+
 /// `text` for a Markdown table cell: a '|' would end the cell.
 std::string markdown_cell(const std::string& text) {
     std::string out;
@@ -146,7 +149,7 @@ void print_markdown(const std::vector<Row>& rows) {
     for (const Row& row : rows) {
         if (!row.error.empty() || !row.skipped.empty()) {
             fmt::print("| {} | {} | {} | {} | | | | | |\n", markdown_cell(row.model), row.algorithm, row.primitives,
-                       row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error);
+                       why_no_numbers(row));
             continue;
         }
         fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", markdown_cell(row.model), row.algorithm,
@@ -160,8 +163,7 @@ void print_text(const std::vector<Row>& rows) {
                "MC", "cost", "height", "vs-2lvl", "gap-opt");
     for (const Row& row : rows) {
         if (!row.error.empty() || !row.skipped.empty()) {
-            fmt::print("{:<20} {:<16} {:>6} {}\n", row.model, row.algorithm, row.primitives,
-                       row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error);
+            fmt::print("{:<20} {:<16} {:>6} {}\n", row.model, row.algorithm, row.primitives, why_no_numbers(row));
             continue;
         }
         fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9.3f} {:>10}{}\n", row.model, row.algorithm,
