@@ -102,6 +102,7 @@ Result<ModelFile> from_import(Result<ImportResult> imported, const std::string& 
     ModelFile model;
     model.primitives = std::move(imported->primitives);
     model.warnings = std::move(imported->warnings);
+    model.imported = true;
     return model;
 }
 

@@ -136,6 +136,10 @@ add_test(NAME cli.atomic_output
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
                  -DWORK=${HBVH_CLI_OUT}/atomic -P ${CMAKE_CURRENT_LIST_DIR}/atomic_output.cmake)
 
+add_test(NAME cli.output_over_input
+         COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
+                 -DWORK=${HBVH_CLI_OUT}/output_over_input -P ${CMAKE_CURRENT_LIST_DIR}/output_over_input.cmake)
+
 # 2 x 10^4 coincident spheres (tools/bad_input.sh runs 10^6 for docs/bad-input.md; too slow for every CI run). At
 # this size the default builder, auto, runs binned alone (n > auto_portfolio_max_primitives 2000): every centroid
 # falls in one bin, so ranges over 16 are cut at their median and smaller ones sweep cuts that all tie; 1.3 s

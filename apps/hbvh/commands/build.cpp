@@ -78,6 +78,10 @@ std::function<void(double)> progress_bar(std::chrono::steady_clock::time_point s
 int run_build(const BuildArguments& args) {
     Result<Model> model = load_model(args.input, args.format);
     if (!model) return report_error(model.error());
+    if (const std::string problem = output_replaces_input(args.input, args.output, model->imported); !problem.empty()) {
+        fmt::print(stderr, "hbvh build: {}\n", problem);
+        return exit_bad_usage;
+    }
     report_warnings(model->warnings);
     if (Status stored = check_stored_hierarchy(model.value(), args.builder); !stored) return report_error(stored.error());
     Result<BuildRequest> request = args.builder.resolve();

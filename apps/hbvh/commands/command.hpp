@@ -46,6 +46,12 @@ struct Model : ModelFile {
 
 /// Reads INPUT ("-" = stdin) in the format its extension says, or `format` when given.
 [[nodiscard]] Result<Model> load_model(const std::string& path, const std::string& format = {});
+/// Empty, or why writing `output` would destroy the input: `output` is the file `input` names (by any path or link)
+/// and that file is an imported model (`input_imported`: MJCF, URDF or a mesh, of which survey XML and .hbvh keep only
+/// the primitives) or, with `any_input`, anything (export's glTF, DOT or SVG in place of the file it was made from).
+/// The caller prints it as a usage error (exit 2); an atomic write would otherwise replace the model silently.
+[[nodiscard]] std::string output_replaces_input(const std::string& input, const std::string& output,
+                                                bool input_imported, bool any_input = false);
 /// Writes `content` to `path` atomically, or to stdout for "-".
 [[nodiscard]] Status write_output(const std::string& path, const std::string& content);
 /// Prints "hbvh: <where>: <message>" to stderr and returns exit_bad_input.

@@ -51,6 +51,18 @@ Result<Model> load_model(const std::string& path, const std::string& format) {
     return model;
 }
 
+std::string output_replaces_input(const std::string& input, const std::string& output, bool input_imported,
+                                  bool any_input) {
+    if (input == "-" || output == "-" || !(input_imported || any_input)) return {};
+    std::error_code error;
+    // equivalent() follows links and compares devices and inodes, so "./robot.xml", a hard link or a symbolic link
+    // to the input are caught as well; an output that does not exist yet (the usual case) is an error, not a match.
+    if (!std::filesystem::equivalent(input, output, error) || error) return {};
+    return "the output '" + output + "' is the input file" +
+           (input_imported ? " (an imported model, of which the output would keep only the primitives)" : "") +
+           ": writing it would replace the input; give another output name";
+}
+
 Status write_output(const std::string& path, const std::string& content) {
     if (path == "-") {
         errno = 0;

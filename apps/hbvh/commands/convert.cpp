@@ -1,5 +1,7 @@
 // SPDX-License-Identifier: MIT
 // `hbvh convert`: MJCF, URDF or a mesh in, the survey's primitive XML out.
+#include <fmt/core.h>
+
 #include <optional>
 
 #include "commands/command.hpp"
@@ -30,6 +32,11 @@ void add_convert_command(CLI::App& app, Command& command) {
         command = [args] {
             Result<Model> model = load_model(args->input, args->format);
             if (!model) return report_error(model.error());
+            if (const std::string problem = output_replaces_input(args->input, args->output, model->imported);
+                !problem.empty()) {
+                fmt::print(stderr, "hbvh convert: {}\n", problem);
+                return exit_bad_usage;
+            }
             report_warnings(model->warnings);
             // A stored hierarchy is checked like everywhere else: converting must not turn a file whose
             // volumes miss their primitives into a binary one that looks trustworthy.

@@ -1,5 +1,6 @@
 // SPDX-License-Identifier: MIT
 // `hbvh export`: pictures of a hierarchy's levels (glTF 2.0) or of its tree (Graphviz DOT, or SVG via dot).
+#include <fmt/core.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -105,6 +106,11 @@ int run_export(const ExportArguments& args) {
     Result<std::string> format = export_format(args);
     if (!format) {
         report_error(format.error());
+        return exit_bad_usage;
+    }
+    // glTF, DOT and SVG are no input of hbvh's, so an export over its own input loses it whatever that was.
+    if (const std::string problem = output_replaces_input(args.input, args.output, false, true); !problem.empty()) {
+        fmt::print(stderr, "hbvh export: {}\n", problem);
         return exit_bad_usage;
     }
     Result<Model> model = load_model(args.input, args.input_format);

@@ -24,6 +24,9 @@ struct ModelFile {
     std::optional<Bvh> hierarchy;  ///< Its primitives are `primitives`, in the same order.
     std::vector<std::string> warnings;
     std::vector<int> node_lines;  ///< XmlModel::node_lines; empty for other formats.
+    /// Read by an importer (MJCF, URDF, a mesh): the file holds more than its primitives, and neither survey XML
+    /// nor .hbvh written in its place would keep it.
+    bool imported = false;
 };
 
 /// The line of stored node `node` in its file, from ModelFile::node_lines; 0 when unknown (a binary file, a node
