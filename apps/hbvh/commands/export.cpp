@@ -2,6 +2,7 @@
 // `hbvh export`: pictures of a hierarchy's levels (glTF 2.0) or of its tree (Graphviz DOT, or SVG via dot).
 #include <fmt/core.h>
 #include <spawn.h>
+#include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <string>
+#include <thread>
 
 #include "commands/command.hpp"
 #include "hbvh/io/export_dot.hpp"
@@ -64,40 +67,81 @@ std::filesystem::path find_on_path(const std::string& program) {
     return {};
 }
 
-/// Renders DOT text to SVG with Graphviz's `dot`, through a private temporary directory (dot reads and
-/// writes files; no shell is involved, so no quoting of user paths can go wrong).
+/// A file descriptor closed when it goes out of scope.
+class Descriptor {
+public:
+    explicit Descriptor(int fd = -1) : fd_(fd) {}
+    Descriptor(const Descriptor&) = delete;
+    Descriptor& operator=(const Descriptor&) = delete;
+    ~Descriptor() { close(); }
+    [[nodiscard]] int get() const { return fd_; }
+    void close() {
+        if (fd_ >= 0) ::close(fd_);
+        fd_ = -1;
+    }
+
+private:
+    int fd_;
+};
+
+/// Renders DOT text to SVG with Graphviz's `dot`, through its standard input and output. No shell is involved, so
+/// no quoting of user paths can go wrong, and no scratch file either: until 2026-12-08 dot read and wrote files in a
+/// private temporary directory, which a signal ending hbvh mid-render left behind in $TMPDIR.
 Result<std::string> render_svg(const std::string& dot_text) {
     const std::filesystem::path dot = find_on_path("dot");
     if (dot.empty()) return Error{"Graphviz 'dot' was not found on PATH; install graphviz, or write .dot instead"};
-    // The error_code form: the throwing one ended the process when TMPDIR names no directory.
-    std::error_code no_temp;
-    const std::filesystem::path temp = std::filesystem::temp_directory_path(no_temp);
-    if (no_temp) return Error{"no directory for temporary files (TMPDIR names none): " + no_temp.message()};
-    std::string pattern = (temp / "hbvh-export-XXXXXX").string();
-    if (::mkdtemp(pattern.data()) == nullptr)
-        return Error{"cannot create a temporary directory in " + temp.string() + ": " + std::strerror(errno)};
-    const std::filesystem::path dir = pattern;
-    // Removes the directory however this function ends.
-    const auto cleanup = std::unique_ptr<const std::filesystem::path, void (*)(const std::filesystem::path*)>(
-        &dir, [](const std::filesystem::path* d) {
-            std::error_code ignored;
-            std::filesystem::remove_all(*d, ignored);
-        });
-    const std::string in = (dir / "tree.dot").string();
-    const std::string out = (dir / "tree.svg").string();
-    if (Status written = write_file_atomic(in, dot_text); !written) return written.error();
-
+    // One connected socket pair rather than two pipes: the child's end is its stdin and stdout, and the parent's
+    // send(MSG_NOSIGNAL) turns a dot that exits before reading everything into an error instead of a SIGPIPE.
+    int ends[2];
+    if (::socketpair(AF_UNIX, SOCK_STREAM | SOCK_CLOEXEC, 0, ends) != 0)
+        return Error{std::string("cannot connect to Graphviz 'dot': ") + std::strerror(errno)};
+    Descriptor ours(ends[0]);
+    Descriptor theirs(ends[1]);
+    posix_spawn_file_actions_t actions;
+    ::posix_spawn_file_actions_init(&actions);
+    // dup2 clears close-on-exec on the copies, so the child keeps exactly these two.
+    ::posix_spawn_file_actions_adddup2(&actions, theirs.get(), STDIN_FILENO);
+    ::posix_spawn_file_actions_adddup2(&actions, theirs.get(), STDOUT_FILENO);
     std::string program = dot.string();
-    std::string type_flag = "-Tsvg", output_flag = "-o";
-    std::string in_path = in, out_path = out;
-    char* argv[] = {program.data(), type_flag.data(), in_path.data(), output_flag.data(), out_path.data(), nullptr};
+    std::string type_flag = "-Tsvg";
+    char* argv[] = {program.data(), type_flag.data(), nullptr};
     pid_t child = 0;
-    if (::posix_spawn(&child, program.c_str(), nullptr, nullptr, argv, environ) != 0)
-        return Error{"cannot run " + program};
+    const int spawned = ::posix_spawn(&child, program.c_str(), &actions, nullptr, argv, environ);
+    ::posix_spawn_file_actions_destroy(&actions);
+    if (spawned != 0) return Error{"cannot run " + program + ": " + std::strerror(spawned)};
+    theirs.close();  // so that the parent sees the end of dot's output when dot exits
+
+    // dot may write while it still reads, so the text goes in on a thread of its own while this one reads.
+    bool sent = true;
+    std::thread sender([&] {
+        std::size_t offset = 0;
+        while (offset < dot_text.size()) {
+            const ssize_t n = ::send(ours.get(), dot_text.data() + offset, dot_text.size() - offset, MSG_NOSIGNAL);
+            if (n < 0 && errno == EINTR) continue;
+            if (n <= 0) {
+                sent = false;
+                break;
+            }
+            offset += static_cast<std::size_t>(n);
+        }
+        ::shutdown(ours.get(), SHUT_WR);  // end of input for dot
+    });
+    std::string svg;
+    char buffer[1 << 16];
+    for (;;) {
+        const ssize_t n = ::read(ours.get(), buffer, sizeof buffer);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) break;
+        svg.append(buffer, static_cast<std::size_t>(n));
+    }
+    sender.join();
     int status = 0;
-    if (::waitpid(child, &status, 0) < 0 || !WIFEXITED(status) || WEXITSTATUS(status) != 0)
+    pid_t waited = 0;
+    do waited = ::waitpid(child, &status, 0);
+    while (waited < 0 && errno == EINTR);
+    if (waited < 0 || !sent || !WIFEXITED(status) || WEXITSTATUS(status) != 0 || svg.empty())
         return Error{"Graphviz 'dot' failed to render the tree (see its message above)"};
-    return read_text_file(out);
+    return svg;
 }
 
 int run_export(const ExportArguments& args) {
