@@ -247,8 +247,11 @@ RigidTransform pose_of(const py::handle& object, const char* name) {
     py::ssize_t unused = -1;
     if (py::isinstance<py::tuple>(object) && py::len(object) == 2) {
         const auto parts = object.cast<py::tuple>();
-        const DoubleArray rotation = checked_array(parts[0], name, {3, 3}, unused);
-        const DoubleArray translation = checked_array(parts[1], name, {3}, unused);
+        // Each part is named in its errors: "pose_a must have shape (3,)" did not say it was the translation.
+        const std::string rotation_name = std::string(name) + "'s rotation R of (R, t)";
+        const std::string translation_name = std::string(name) + "'s translation t of (R, t)";
+        const DoubleArray rotation = checked_array(parts[0], rotation_name.c_str(), {3, 3}, unused);
+        const DoubleArray translation = checked_array(parts[1], translation_name.c_str(), {3}, unused);
         const Mat3 r = mat3_at(rotation, 0);
         return {narrow_floats(parts[0]) ? float32_rotation_repaired(r) : r, vec3_at(translation, 0)};
     }
@@ -361,6 +364,8 @@ py::array_t<std::int64_t> pair_array(const CollideResult& result) {
 /// Paths are str or os.PathLike (pathlib.Path), as open() takes them.
 py::object load(const std::filesystem::path& file, const std::string& format, bool refit) {
     const std::string path = file.string();
+    // An empty path named no file in its error ("cannot open for reading: No such file or directory").
+    if (path.empty()) raise(Error{"path: the path is empty"});
     // The argument's own error, before the file is opened (the CLI's --format is a usage error too).
     if (std::string problem = input_format_problem(format); !problem.empty()) raise(Error{"format: " + problem});
     Result<ModelFile> read = read_model_file(path, format);

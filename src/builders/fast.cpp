@@ -174,14 +174,18 @@ Result<Bvh> build_fast(std::span<const Primitive> primitives, const BuildContext
         early.start(std::move(all));
     }
     const std::size_t notes_before = context.report != nullptr ? context.report->notes.size() : 0;
+    const bool stopped_before = context.report != nullptr && !context.report->time_limit.empty();
     Result<Bvh> built =
         build_binned(primitives, first_step, cheap_binned(sweep ? std::min(options.treelet_units, BinnedOptions{}.max_children)
                                                                 : BinnedOptions{}.max_children, options.lookahead_candidates));
     // binned's notes ("binned: time limit reached ...") are the preset's first step's: a user who asked for fast
-    // reads fast's name first.
-    if (context.report != nullptr)
+    // reads fast's name first, in the notes and in the time-limit line that the CLI and Python warn with.
+    if (context.report != nullptr) {
         for (std::size_t i = notes_before; i < context.report->notes.size(); ++i)
             context.report->notes[i].insert(0, "fast: the first step, ");
+        if (!stopped_before && !context.report->time_limit.empty())
+            context.report->time_limit.insert(0, "fast: the first step, ");
+    }
     if (!built || context.expired()) return built;
     Bvh& bvh = *built;
     // binned's cuts are priced by boxes and never revisited; on small objects that topology, not the fits, is

@@ -155,15 +155,15 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         if (survey) return from_xml(detail::read_xml_taking(std::move(text).value(), path));
         if (by_bytes)
             return Error{"unknown file type '" + extension +
-                             "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format with --format (--input-format "
-                             "in hbvh export: hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
+                             "': neither .hbvh bytes nor survey XML (<hierarchy>); name the format (the CLI's --format, --input-format "
+                             "in hbvh export, Python's format=: hbvh, xml, mjcf, urdf, mesh or mesh-nodes) or give the file one of the extensions "
                              ".hbvh, .xml, .urdf, .gltf, .glb, .obj, .fbx, .dae, .stl, .ply",
                          path};
     }
     // An importer would read a binary hierarchy as XML or a mesh and report a "line" of it; say what it is instead.
     if (!automatic && starts_with_binary_magic(path))
         return Error{"the file is an .hbvh hierarchy (its first bytes say so), not " + std::string(format) +
-                         "; drop --format, or give --format hbvh",
+                         "; drop the format (--format, Python's format=), or name it hbvh",
                      path};
     return from_import(import_primitives(path, chosen->second), path);
 }

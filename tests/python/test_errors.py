@@ -212,3 +212,32 @@ def test_a_type_weight_that_is_no_number_names_its_entry():
     for weight in ["x", None]:
         with pytest.raises(TypeError, match=r"type_weights\['obb'\] must be a number"):
             hbvh.build(pair, type_weights={"obb": weight})
+
+
+def test_fast_stopped_by_its_time_limit_warns_in_its_own_name():
+    # The warning named the preset's first step ("binned: ..."), a builder the user never asked for.
+    rng = np.random.default_rng(1)
+    spheres = hbvh.spheres(rng.uniform(0, 10, (100, 3)), rng.uniform(0.1, 1, 100))
+    with pytest.warns(UserWarning, match="^time_limit reached: fast: the first step, binned: time limit reached"):
+        hbvh.build(spheres, algorithm="fast", time_limit=1e-9)
+
+
+def test_an_empty_path_and_a_pose_part_of_the_wrong_shape_say_which_argument():
+    # load("") said "cannot open for reading: No such file or directory" without a name; a (R, t) pose whose t had
+    # two numbers said "pose_a must have shape (3,)", which a 4x4 pose cannot have.
+    with pytest.raises(hbvh.Error, match="^path: the path is empty"):
+        hbvh.load("")
+    pair = hbvh.build(hbvh.spheres([[0, 0, 0], [3, 0, 0]], [1.0, 1.0]))
+    with pytest.raises(ValueError, match=r"pose_a's translation t of \(R, t\) must have shape \(3,\), got \(2,\)"):
+        hbvh.collide(pair, (np.eye(3), np.zeros(2)), pair, None)
+    with pytest.raises(ValueError, match=r"pose_b's rotation R of \(R, t\) must have shape \(3, 3\), got \(3, 2\)"):
+        hbvh.collide(pair, None, pair, (np.zeros((3, 2)), np.zeros(3)))
+
+
+def test_a_file_whose_format_cannot_be_told_names_pythons_argument(tmp_path):
+    # The message told the CLI's --format only.
+    unnamed = tmp_path / "model"
+    unnamed.write_text('<mujoco><worldbody><geom type="sphere" size="1"/></worldbody></mujoco>')
+    with pytest.raises(hbvh.Error, match="Python's format="):
+        hbvh.load(unnamed)
+    assert len(hbvh.load(unnamed, format="mjcf").names) == 1
