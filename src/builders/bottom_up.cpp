@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "hbvh/assert.hpp"
+#include "guarded_build.hpp"
 #include "hbvh/fit/fit.hpp"
 
 namespace hbvh {
@@ -92,8 +93,7 @@ const FittedGroup& Level::fit_group(std::span<const std::uint32_t> members) cons
     HBVH_ASSERT(!members.empty());
     std::vector<std::uint32_t> key(members.begin(), members.end());
     if (auto found = fitted_.find(key); found != fitted_.end()) return found->second;
-    if (deadline_ != std::chrono::steady_clock::time_point::max() && std::chrono::steady_clock::now() >= deadline_)
-        throw LevelDeadlinePassed{};
+    check_deadline();
     // Fit around the primitives themselves (Definition 1.2: a BV need only cover coverage(n)), in member
     // order and each node's canonical primitive order, so the fitters always see the same sphere sequence.
     FitInput input;
@@ -104,6 +104,11 @@ const FittedGroup& Level::fit_group(std::span<const std::uint32_t> members) cons
     BoundingVolume volume = fit_best(input.spheres, policy_, input.hint_axes);
     const double weighted = policy_.weighted_volume(volume);
     return fitted_.emplace(std::move(key), FittedGroup{std::move(volume), weighted}).first->second;
+}
+
+void Level::check_deadline() const {
+    if (deadline_ != std::chrono::steady_clock::time_point::max() && std::chrono::steady_clock::now() >= deadline_)
+        throw LevelDeadlinePassed{};
 }
 
 double Level::candidate_cost(std::span<const std::uint32_t> members) const {
@@ -241,10 +246,8 @@ Bvh build_bottom_up(std::span<const Primitive> primitives, const VolumePolicy& p
     const double primitive_count = static_cast<double>(primitives.size());
     // Anytime: once the deadline has passed, the levels built so far stay and one root takes the rest.
     const auto root_over_the_rest = [&](std::span<const LevelNode> left) {
-        FitInput input;
-        for (const LevelNode& node : left)
-            for (std::uint32_t p : node.primitives) input.add(primitives[p].volume);
-        const std::uint32_t root = assembler.add_group(ids, fit_best(input.spheres, policy, input.hint_axes));
+        // The nodes left cover every primitive; past the deadline their root is fitted quickly.
+        const std::uint32_t root = assembler.add_group(ids, detail::root_volume(primitives, policy, detail::RootFit::quick));
         options.checkpoint->context().note_deadline("time limit reached after " + std::to_string(level_index) +
                                                     " levels; one root over the " + std::to_string(left.size()) +
                                                     " nodes left");

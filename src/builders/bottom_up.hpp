@@ -64,6 +64,9 @@ public:
     /// the survey's candidate heuristics fit O(n^2) groups a level, minutes at 900 nodes, and the deadline is
     /// otherwise seen only between levels. time_point::max(): never (the default).
     void stop_fitting_after(std::chrono::steady_clock::time_point deadline) { deadline_ = deadline; }
+    /// Throws LevelDeadlinePassed once stop_fitting_after's deadline has passed: for the heuristics' loops that
+    /// fit nothing (B&B-Enlarge's growth tests every pair of nodes, seconds at 2000 nodes and minutes at 20 000).
+    void check_deadline() const;
 
 private:
     std::span<const Primitive> primitives_;

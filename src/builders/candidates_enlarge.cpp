@@ -99,6 +99,7 @@ std::vector<std::vector<std::uint32_t>> enlarge_candidates(const Level& level, c
     const std::uint32_t wanted = std::min(std::max<std::uint32_t>(options.min_collisions, 1), n - 1);
     std::vector<std::vector<std::uint32_t>> sets;
     for (std::uint32_t i = 0; i < n; ++i) {
+        level.check_deadline();  // each node tests every other: the only place this heuristic can stop in time
         const BoundingVolume& bv = level.nodes()[i].volume;
         const std::uint32_t last = last_step(bv, level.bounds(), options);
         // (first colliding step, squared centre distance, node) for every node B ever reaches.

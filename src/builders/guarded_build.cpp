@@ -27,7 +27,7 @@ Result<Bvh> check_build_output(Result<Bvh> built, std::string_view builder) {
 Bvh tree_at_deadline(std::span<const Primitive> primitives, const BuildContext& context, std::string_view builder) {
     context.note_deadline(std::string(builder) + ": time limit reached before the tree was done; returned the "
                           "two-level tree (one root over every primitive)");
-    return two_level_tree(primitives, context.policy);
+    return two_level_tree(primitives, context.policy, RootFit::quick);
 }
 
 }  // namespace hbvh::detail

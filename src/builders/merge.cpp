@@ -56,6 +56,7 @@ public:
 
     std::uint32_t build() {
         for (std::uint32_t local = 0; local < set_.size(); ++local) {
+            if (local % 64 == 0) checkpoint_.step(0.0);  // alive_count_ is set after this loop
             GraphNode node;
             node.covered = {local};
             node.members = {assembler_.add_leaf(set_.input_index(local))};
@@ -66,7 +67,7 @@ public:
         alive_count_ = set_.size();
         // Stage 1: collapse edges until one graph-node is left, reconnecting whenever edges run out.
         while (alive_count_ > 1) {
-            checkpoint_.step(static_cast<double>(set_.size() - alive_count_));
+            checkpoint();
             if (edge_count_ == 0) connect();
             const Edge edge = pop_live_edge();
             collapse(edge);
@@ -80,6 +81,10 @@ public:
     }
 
 private:
+    /// The deadline and progress, between collapses and inside the loops that build the graph: at 20 000
+    /// primitives pricing the first edges alone took seconds, and a 0.5 s limit was kept only after 4-5 s.
+    void checkpoint() const { checkpoint_.step(static_cast<double>(set_.size() - alive_count_)); }
+
     // Builds edges among all live graph-nodes by the enlarged-BV overlap rule (survey §2.3), enlarging
     // isolated nodes again until each has an edge: the survey's fix for the fixed 25 % leaving nodes alone.
     void connect() {
@@ -111,9 +116,11 @@ private:
         std::sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) {
             return boxes[a].min.x() != boxes[b].min.x() ? boxes[a].min.x() < boxes[b].min.x() : a < b;
         });
-        for (std::size_t s = 0; s < count; ++s)
+        for (std::size_t s = 0; s < count; ++s) {
+            checkpoint();
             for (std::size_t t = s + 1; t < count && boxes[by_x[t]].min.x() <= boxes[by_x[s]].max.x(); ++t)
                 try_pair(by_x[s], by_x[t]);
+        }
 
         for (int round = 0; round < max_enlargement_rounds; ++round) {
             std::vector<std::size_t> isolated;
@@ -124,9 +131,11 @@ private:
                 factor[i] *= enlargement_;
                 grow(i);
             }
-            for (const std::size_t i : isolated)
+            for (const std::size_t i : isolated) {
+                checkpoint();
                 for (std::size_t j = 0; j < count; ++j)
                     if (j != i && !has_edge(live[i], live[j])) try_pair(i, j);
+            }
         }
         for (std::size_t i = 0; i < count; ++i)
             if (!connected[i]) connect_nearest(live, i, connected);

@@ -5,6 +5,7 @@
 
 #include "guarded_build.hpp"
 #include "hbvh/fit/fit.hpp"
+#include "hbvh/fit/fit_fast.hpp"
 
 namespace hbvh {
 
@@ -14,16 +15,19 @@ Result<Bvh> build_two_level(std::span<const Primitive> primitives, const BuildCo
                                  [&](const detail::Checkpoint&) { return detail::two_level_tree(primitives, context.policy); });
 }
 
-Bvh detail::two_level_tree(std::span<const Primitive> primitives, const VolumePolicy& policy) {
+BoundingVolume detail::root_volume(std::span<const Primitive> primitives, const VolumePolicy& policy, RootFit fit) {
+    FitInput input;
+    for (const Primitive& primitive : primitives) input.add(primitive.volume);
+    if (fit == RootFit::quick) return fit_fast(input.spheres, {}, policy, FastFitMode::quick_sphere);
+    return fit_best(input.spheres, policy, input.hint_axes);
+}
+
+Bvh detail::two_level_tree(std::span<const Primitive> primitives, const VolumePolicy& policy, RootFit fit) {
     TreeAssembler assembler(primitives);
     std::vector<std::uint32_t> leaves(primitives.size());
-    FitInput input;
-    for (std::uint32_t i = 0; i < primitives.size(); ++i) {
-        leaves[i] = assembler.add_leaf(i);
-        input.add(primitives[i].volume);
-    }
+    for (std::uint32_t i = 0; i < primitives.size(); ++i) leaves[i] = assembler.add_leaf(i);
     if (leaves.size() == 1) return std::move(assembler).finish(leaves.front());
-    const std::uint32_t root = assembler.add_group(leaves, fit_best(input.spheres, policy, input.hint_axes));
+    const std::uint32_t root = assembler.add_group(leaves, root_volume(primitives, policy, fit));
     return std::move(assembler).finish(root);
 }
 

@@ -14,6 +14,7 @@
 #include "support/test_helpers.hpp"
 #include "hbvh/builders/binned.hpp"
 #include "hbvh/builders/build.hpp"
+#include "hbvh/builders/merge.hpp"
 #include "hbvh/builders/scale.hpp"
 #include "hbvh/builders/treelet.hpp"
 #include "hbvh/scene/generate.hpp"
@@ -118,11 +119,32 @@ TEST(Scale, ReportsProgressUpToOne) {
 TEST(Scale, TimeLimitStillGivesAValidTree) {
     const std::vector<Primitive> primitives = generated_scene(2000, 9);
     BuildReport report;
-    // Past at once: every window keeps its initial cover.
+    // Past at once: no window makes groups (each still fitted its candidates for an initial cover, and 10^5
+    // primitives took 4.6 s under a 0.5 s limit), and one root takes every node of the level.
     const BuildContext context = test_support::context_for(VolumePolicy::all(), &report).with_time_limit(1e-6);
     const Bvh bvh = build_scale(primitives, context).value();
     expect_tree_properties(primitives, bvh);
     EXPECT_TRUE(report.budget_hit);
+    EXPECT_EQ(bvh.nodes.front().child_count, 2000u);
+    EXPECT_NE(report.time_limit.find("scale: the time limit passed during level 0; one root over the 2000 nodes left"),
+              std::string::npos)
+        << report.time_limit;
+}
+
+TEST(Merge, ChecksItsDeadlineWhileBuildingItsGraph) {
+    // merge priced every node and every first edge before its first collapse, the only place it looked at the
+    // deadline: 20 000 primitives took 4-5 s under a 0.5 s limit. The checks between (which report progress too)
+    // are counted here: before the first collapse there used to be one, the guard's.
+    const std::vector<Primitive> primitives = generated_scene(1000, 4);
+    BuildContext context;
+    std::size_t before_first_collapse = 0;
+    bool collapsed = false;
+    context.progress = [&](double fraction) {
+        collapsed = collapsed || fraction > 0.0;
+        if (!collapsed) ++before_first_collapse;
+    };
+    ASSERT_TRUE(build_merge(primitives, context).has_value());
+    EXPECT_GT(before_first_collapse, 1000u / 64u);
 }
 
 TEST(Auto, PicksBySizeAndSaysSo) {
