@@ -80,7 +80,8 @@ public:
     /// Converts `bvh` after check_structure(bvh) (linear time): a malformed Bvh (child ranges past the end,
     /// a non-breadth-first order, NaN or negative geometry, a box whose axes are no rotation) throws
     /// InvalidHierarchy instead of being read out of bounds or pruned on. Whether volumes enclose their
-    /// primitives is validate()'s job (a full check is O(n log n)), run by every CLI command on stored files.
+    /// primitives is validate()'s job (every node against every primitive below it: O(n log n) for a balanced
+    /// tree, quadratic for a chain), run by every CLI command on stored files.
     /// An empty Bvh gives an empty tree, which collides with nothing.
     explicit QueryTree(const Bvh& bvh);
     /// As the constructor, returning the Error instead of throwing.

@@ -37,7 +37,9 @@ struct ContainmentViolation {
 };
 
 /// Every node that does not enclose all the primitives below it (within containment_tolerance), each with
-/// its worst primitive, in node order. Precondition: check_structure(bvh) passed.
+/// its worst primitive, in node order. Precondition: check_structure(bvh) passed. Every node is held against
+/// every generating sphere below it, on every core: O(n x height), so n log n for a balanced tree and quadratic
+/// for a chain (40 000 deep: about a second).
 [[nodiscard]] std::vector<ContainmentViolation> containment_violations(
     const Bvh& bvh, double relative_tolerance = default_containment_tolerance);
 
