@@ -110,16 +110,14 @@ Status collect_instances(const aiScene& scene, const aiNode& node, const aiMatri
     return Ok{};
 }
 
-// Whether a fitted volume has positive size in every dimension the survey format writes (sphere and capsule
-// radius, every box extent). Vertices that all coincide, or lie on a line or in a plane, fit volumes with a zero
-// size: valid primitives, but in a collision mesh a stand-in or a mistake more often than a shape, so they are
-// skipped with a warning, as URDF's zero-size placeholders are.
-bool has_positive_size(const BoundingVolume& volume) {
-    if (const auto* sphere = std::get_if<Sphere>(&volume)) return sphere->radius > 0.0;
-    if (const auto* capsule = std::get_if<Capsule>(&volume)) return capsule->radius > 0.0;
-    if (const auto* box = std::get_if<Obb>(&volume)) return (box->half_extents.array() > 0.0).all();
-    const Aabb& box = std::get<Aabb>(volume);
-    return (box.max.array() > box.min.array()).all();
+// Whether a fitted volume is a single point (every vertex of the mesh at one place): nothing to collide with, so
+// skipped with a warning, as URDF's points are. A flat mesh (a floor, a wall, a sign) fits a box of zero thickness
+// and a line of vertices a capsule of radius zero: valid primitives that the survey format keeps (zero sizes are
+// allowed), which until 2026-12-08 were skipped as well, although a UBX_ floor that rounding left a tiny thickness
+// was kept.
+bool is_a_point(const BoundingVolume& volume) {
+    const Aabb box = world_aabb(volume);
+    return box.min == box.max;
 }
 
 }  // namespace
@@ -166,12 +164,10 @@ Result<ImportResult> import_mesh(const std::string& path, const MeshImportOption
             case CollisionKind::convex:
             case CollisionKind::none: volume = fit_best(instance.points, options.policy); break;
         }
-        if (!has_positive_size(volume)) {
-            // Like URDF's zero-size placeholders: nothing to collide with, so skipped rather than fatal.
-            result.warnings.push_back(Error("mesh '" + instance.name + "' is flat or a single point (its " +
-                                                std::string(to_string(type_of(volume))) + " has a zero size); skipped",
-                                            path)
-                                          .to_string());
+        if (is_a_point(volume)) {
+            result.warnings.push_back(
+                Error("mesh '" + instance.name + "' is a single point (all its vertices coincide); skipped", path)
+                    .to_string());
             continue;
         }
         // The fit encloses the vertices as assimp gave them; grown by their rounding, the file's own vertices too.

@@ -163,7 +163,7 @@ TEST(ImportRegressions, PlyHeaderGrammarIsChecked) {
 
 // Coincident, collinear or coplanar collision pieces fitted zero-size volumes (a radius-0 sphere, a box of height
 // 0), which `hbvh convert` wrote and every XML reader of hbvh then refused.
-TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
+TEST(ImportRegressions, PointCollisionMeshesAreSkippedWithAWarningFlatOnesKept) {
     const ScratchFolder folder("degenerate_mesh");
     const std::string path = folder.write("pieces.obj",
                                           "o USP_point\nv 1 2 3\np 1\n"
@@ -181,6 +181,10 @@ TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
                            [&](const Primitive& p) { return p.name == name; });
     };
     EXPECT_TRUE(has_primitive("UBX_crate"));
+    // A line and a flat quad are shapes (a capsule of radius 0, a box of zero height), kept as URDF's rods and
+    // plates are; until 2026-12-08 they were skipped with the points, unless rounding left them a tiny size.
+    EXPECT_TRUE(has_primitive("UCP_line"));
+    EXPECT_TRUE(has_primitive("UBX_floor"));
     // A single point and two coincident points have size exactly zero: skipped, each with a warning.
     for (const char* name : {"USP_point", "UCX_point"}) {
         EXPECT_FALSE(has_primitive(name)) << name;
@@ -189,6 +193,23 @@ TEST(ImportRegressions, DegenerateCollisionMeshesAreSkippedWithAWarning) {
         });
         EXPECT_TRUE(warned) << name;
     }
+}
+
+// A plain mesh read one primitive per node (mesh-nodes): an axis-aligned floor fitted a box of zero height and was
+// dropped with a warning, so a file of only a floor was refused (an asset-pipeline review, 2026-12-08).
+TEST(ImportRegressions, AFlatRenderMeshIsAFlatBoxOnePrimitivePerNode) {
+    const ScratchFolder folder("flat_render_mesh");
+    const std::string path = folder.write("floor.obj", "o floor\nv -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n");
+    MeshImportOptions options;
+    options.one_primitive_per_mesh = true;
+    const Result<ImportResult> imported = import_mesh(path, options);
+    ASSERT_TRUE(imported.has_value()) << imported.error().to_string();
+    ASSERT_EQ(imported->primitives.size(), 1u);
+    const Aabb box = world_aabb(imported->primitives.front().volume);
+    EXPECT_NEAR(box.min.x(), -1.0, 1e-6);
+    EXPECT_NEAR(box.max.y(), 1.0, 1e-6);
+    EXPECT_NEAR(box.max.z() - box.min.z(), 0.0, 1e-5);  // grown by the vertices' single-precision rounding
+    expect_round_trip(*imported);
 }
 
 // Sizes and positions near the limit of double were accepted although the volume could not be written (a half
