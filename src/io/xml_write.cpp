@@ -29,9 +29,11 @@ using detail::exact_capsule_fields;
 
 constexpr std::string_view declaration = "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n";
 
-/// An attribute value as pugixml escapes it: & < " as entities (not >, which needs none in a value), control characters as "&#NN;" (two
-/// digits), everything else, UTF-8 included, as it is. pugixml took the value as a C string, so a name
-/// ends at its first NUL.
+/// An attribute value as pugixml escapes it: & < " as entities (not >, which needs none in a value), tab, line
+/// feed and carriage return as "&#NN;" (two digits, so that attribute normalisation keeps them), everything else,
+/// UTF-8 included, as it is; except the other control characters, which XML 1.0 allows in no form, not even as a
+/// reference (libxml2 and expat refuse "&#01;", where pugixml read it), so they are written as U+FFFD, as a name
+/// that is no UTF-8 is. pugixml took the value as a C string, so a name ends at its first NUL.
 template <class Out>
 void append_escaped(Out& out, std::string_view text) {
     text = text.substr(0, text.find('\0'));
@@ -41,8 +43,9 @@ void append_escaped(Out& out, std::string_view text) {
             case '<': out += "&lt;"; break;
             case '"': out += "&quot;"; break;
             default:
-                if (static_cast<unsigned char>(c) < 32) {
-                    const auto code = static_cast<unsigned char>(c);
+                if (const auto code = static_cast<unsigned char>(c); code < 32 && code != '\t' && code != '\n' && code != '\r') {
+                    out += "\xEF\xBF\xBD";  // U+FFFD
+                } else if (code < 32) {
                     out += "&#";
                     out += static_cast<char>('0' + code / 10);
                     out += static_cast<char>('0' + code % 10);

@@ -122,3 +122,16 @@ def test_paths_may_be_pathlib_paths(tmp_path):
     tree = hbvh.build(chair, algorithm="split")
     tree.save(tmp_path / "chair.hbvh")
     assert hbvh.load(tmp_path / "chair.hbvh").cost == tree.cost
+
+
+def test_names_with_control_characters_are_written_as_xml_that_expat_reads(tmp_path):
+    # "&#01;" is no XML 1.0 (libxml2 and expat refuse it; hbvh's own reader did not): control characters other
+    # than tab, line feed and carriage return are now written as U+FFFD, as bytes that are no UTF-8 are.
+    import xml.etree.ElementTree as ElementTree
+    spheres = hbvh.spheres([[0, 0, 0], [3, 0, 0], [6, 0, 0]], [1.0, 1.0, 1.0],
+                           names=["bell\x07", "tab\there", "line\nbreak"])
+    path = tmp_path / "names.xml"
+    hbvh.build(spheres, algorithm="two-level").save(path)
+    written = {element.get("name") for element in ElementTree.parse(path).iter("volume")} - {None}
+    assert written == {"bell\ufffd", "tab\there", "line\nbreak"}
+    assert set(hbvh.load(path).primitives.names) == written
