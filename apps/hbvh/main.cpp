@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <exception>
 #include <new>
+#include <string>
 
 #include "commands/command.hpp"
 #include "hbvh/files.hpp"
@@ -60,6 +61,23 @@ int main(int argc, char** argv) {
     add_export_command(app, command);
     add_view_command(app, command);
     add_calibrate_command(app, command);
+    // CLI11 answers both a misspelt command and an option before any command with "A subcommand is required".
+    if (argc >= 2) {
+        const std::string first = argv[1];
+        const bool known = first == "-h" || first == "--help" || first == "--version" ||
+                           !app.get_subcommands([&](const CLI::App* sub) { return sub->get_name() == first; }).empty();
+        if (!known) {
+            std::string commands;
+            for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+                commands += (commands.empty() ? "" : ", ") + sub->get_name();
+            if (first.starts_with('-'))
+                std::fprintf(stderr, "hbvh: unknown option '%s': options follow a command (hbvh COMMAND --help)\n",
+                             first.c_str());
+            else
+                std::fprintf(stderr, "hbvh: unknown command '%s' (one of: %s)\n", first.c_str(), commands.c_str());
+            return exit_bad_usage;
+        }
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& error) {

@@ -300,3 +300,10 @@ foreach(command build convert generate export view calibrate)
   endif()
   hbvh_cli_test(empty_output_name_${command} 2 "output" ${command} ${input} --output=)
 endforeach()
+
+# A misspelt command and an option before any command both read "A subcommand is required"; they are named now.
+hbvh_cli_test(unknown_command 2 "hbvh: unknown command 'validate' \\(one of: algorithms, build" validate x.xml)
+hbvh_cli_test(option_before_command 2 "hbvh: unknown option '--bogus': options follow a command" --bogus)
+# compare --bnb-nodes -1 wrapped to 2^64 - 1, an unlimited search.
+hbvh_cli_test(compare_negative_bnb_nodes 2 "--bnb-nodes: '-1' is not a whole number"
+              compare ${PROJECT_SOURCE_DIR}/data/models/chair.xml --bnb-nodes -1)

@@ -4,6 +4,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <limits>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -280,8 +281,10 @@ void add_compare_command(CLI::App& app, Command& command) {
                     "Compute the optimum (gap column) for models up to this size, at most the optimal builder's "
                     "limit; above it an `optimal` row is skipped (reported as skipped, with no numbers)")
         ->capture_default_str();
+    // whole_number: CLI11 alone wraps "-1" to 2^64 - 1, an unlimited budget.
     sub->add_option("--bnb-nodes", args->bnb_nodes,
-                    "Search-node budget per solver call of the survey's branch and bound (0 = library default)");
+                    "Search-node budget per solver call of the survey's branch and bound (0 = library default)")
+        ->check(whole_number(0, std::numeric_limits<std::uint64_t>::max()));
     args->builder.add_to(*sub, /*choose_builder=*/false);
     CLI::Option* json = sub->add_flag("--json", args->json, "Print JSON");
     sub->add_flag("--markdown", args->markdown, "Print a Markdown table")->excludes(json);

@@ -36,7 +36,8 @@ inline constexpr double orientation_tolerance = 0.15;
 
 /// Parses `text` (UTF-8 XML). `source_name` is the file name put into every Error ("-" for stdin).
 /// Bad input of any kind (malformed XML, unknown types or attributes, wrong number counts, non-finite
-/// numbers, sizes <= 0, a matrix that is no rotation, ...) gives an Error with its 1-based line;
+/// numbers, negative sizes, a matrix that is no rotation, ...) gives an Error with its 1-based line (a size of
+/// zero is allowed: a flat box, a point sphere, a capsule of radius 0);
 /// it never crashes and never prints.
 [[nodiscard]] Result<XmlModel> read_xml_string(std::string_view text, std::string_view source_name);
 
@@ -46,7 +47,7 @@ inline constexpr double orientation_tolerance = 0.15;
 /// The hierarchy as nested <volume> elements, leaves carrying their primitive's name. Numbers are written
 /// in the shortest form that reads back to the same double. Leaves are written in tree order, so reading
 /// the output back numbers the primitives in that order (which may differ from bvh.primitives' order).
-/// Degenerate values (sizes <= 0, NaN) are written as they are, and the reader will reject them.
+/// Values no hierarchy should hold (negative sizes, NaN) are written as they are, and the reader will reject them.
 /// A tree of a single leaf is written as one volume and so reads back as a one-primitive set;
 /// an empty Bvh is written as an empty <hierarchy/>, which the reader rejects.
 [[nodiscard]] std::string write_xml(const Bvh& bvh);
