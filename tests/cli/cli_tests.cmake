@@ -153,7 +153,7 @@ set_tests_properties(cli.coincident_spheres PROPERTIES TIMEOUT 300)
 # hbvh compare's gap to the optimum and hbvh build's proven bound (every builder on the chair: tens of seconds).
 add_test(NAME cli.compare_gap
          COMMAND ${CMAKE_COMMAND} -DCLI=$<TARGET_FILE:hbvh_cli> -DSOURCE=${PROJECT_SOURCE_DIR}
-                 -P ${CMAKE_CURRENT_LIST_DIR}/compare_gap.cmake)
+                 -DWORK=${HBVH_CLI_OUT} -P ${CMAKE_CURRENT_LIST_DIR}/compare_gap.cmake)
 set_tests_properties(cli.compare_gap PROPERTIES TIMEOUT 900)
 
 # hbvh collide: a pose that is no rigid motion is a usage error (exit 2) whose message names the flag; checked

@@ -8,7 +8,7 @@
 # The optimal builder doubles its work per primitive (10 s on the chair under the sanitizers), so only the first
 # check builds it on the chair; the second and the fourth use the 6-primitive collide_pairs.xml (0.1 s), whose
 # optimum takes the same path.
-#   cmake -DCLI=<hbvh> -DSOURCE=<repo> -P compare_gap.cmake
+#   cmake -DCLI=<hbvh> -DSOURCE=<repo> -DWORK=<scratch dir> -P compare_gap.cmake
 set(chair ${SOURCE}/data/models/chair.xml)
 set(small ${SOURCE}/tests/cli/inputs/collide_pairs.xml)
 set(tie ${SOURCE}/data/models/tie_interceptor.xml)
@@ -100,4 +100,23 @@ endif()
 execute_process(COMMAND ${CLI} build ${chair} -a split --report -o - RESULT_VARIABLE code OUTPUT_QUIET ERROR_VARIABLE err)
 if(NOT code STREQUAL 0 OR NOT err MATCHES "no global bound known")
   message(FATAL_ERROR "build -a split --report (exit ${code}):\n${err}")
+endif()
+
+# An unreadable model is a failed row and the others are still measured, exit 1 (it ended the command with nothing
+# printed for the models before it, 2026-12-08); a model of one primitive has no cost relative to the two-level
+# tree (0/0: null, it printed 1.0).
+file(WRITE ${WORK}/one_sphere.xml "<hierarchy>\n<volume type=\"sphere\" pos=\"0 0 0\" radius=\"1\"/>\n</hierarchy>\n")
+execute_process(COMMAND ${CLI} compare ${small} ${WORK}/no_such_model.xml ${WORK}/one_sphere.xml --repeat 1
+                        --algorithms split --json
+                RESULT_VARIABLE code OUTPUT_VARIABLE rows ERROR_VARIABLE err TIMEOUT 600)
+if(NOT code STREQUAL 1)
+  message(FATAL_ERROR "compare with a missing model: exit ${code}, expected 1:\n${err}")
+endif()
+string(JSON count LENGTH "${rows}")
+string(JSON first_cost GET "${rows}" 0 cost)
+string(JSON missing_error GET "${rows}" 1 error)
+string(JSON lone_relative TYPE "${rows}" 2 relative_to_two_level)
+if(NOT count EQUAL 3 OR NOT first_cost GREATER 0 OR NOT missing_error MATCHES "no_such_model.xml: cannot open"
+   OR NOT lone_relative STREQUAL "NULL")
+  message(FATAL_ERROR "compare rows: ${rows}")
 endif()

@@ -40,7 +40,7 @@ struct Row {
     std::uint32_t candidates = 0;
     double cost = 0.0;
     std::uint32_t height = 0;
-    double relative = 0.0;  ///< cost / two-level cost
+    std::optional<double> relative;  ///< cost / two-level cost; none where both are 0 (one primitive, flat boxes)
     std::optional<double> gap;  ///< cost / optimum - 1, when the model's optimum is known
     std::optional<double> optimum;  ///< Set on `optimal` rows that finished: the proven optimum's Eq. 2 cost
     bool budget_hit = false;
@@ -134,14 +134,19 @@ Row measure(const std::vector<Primitive>& primitives, Algorithm algorithm, const
 /// What a row without a tree prints in place of its numbers: "error: ..." or "skipped: ...".
 std::string why_no_numbers(const Row& row) { return row.error.empty() ? "skipped: " + row.skipped : "error: " + row.error; }
 
-/// `text` for a Markdown table cell: a '|' would end the cell.
+/// `text` for a Markdown table cell: a '|' would end the cell, a line break the row (a file name may hold either).
 std::string markdown_cell(const std::string& text) {
     std::string out;
     for (const char c : text) {
         if (c == '|') out += '\\';
-        out += c;
+        out += c == '\n' || c == '\r' ? ' ' : c;
     }
     return out;
+}
+
+/// The cost relative to the two-level tree's, or "-" where that is 0/0.
+std::string format_relative(const std::optional<double>& relative) {
+    return relative ? fmt::format("{:.3f}", *relative) : std::string("-");
 }
 
 void print_markdown(const std::vector<Row>& rows) {
@@ -153,9 +158,9 @@ void print_markdown(const std::vector<Row>& rows) {
                        why_no_numbers(row));
             continue;
         }
-        fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {:.3f} | {} |\n", markdown_cell(row.model), row.algorithm,
+        fmt::print("| {} | {} | {} | {:.3f}{} | {} | {:.6g} | {} | {} | {} |\n", markdown_cell(row.model), row.algorithm,
                    row.primitives, row.median_ms, row.budget_hit ? " (budget hit)" : "", row.candidates, row.cost,
-                   row.height, row.relative, format_gap(row.gap));
+                   row.height, format_relative(row.relative), format_gap(row.gap));
     }
 }
 
@@ -167,8 +172,8 @@ void print_text(const std::vector<Row>& rows) {
             fmt::print("{:<20} {:<16} {:>6} {}\n", row.model, row.algorithm, row.primitives, why_no_numbers(row));
             continue;
         }
-        fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9.3f} {:>10}{}\n", row.model, row.algorithm,
-                   row.primitives, row.median_ms, row.candidates, row.cost, row.height, row.relative,
+        fmt::print("{:<20} {:<16} {:>6} {:>11.3f} {:>6} {:>14.6g} {:>6} {:>9} {:>10}{}\n", row.model, row.algorithm,
+                   row.primitives, row.median_ms, row.candidates, row.cost, row.height, format_relative(row.relative),
                    format_gap(row.gap), row.budget_hit ? "  budget-hit" : "");
     }
 }
@@ -178,7 +183,8 @@ void print_json(const std::vector<Row>& rows) {
     for (const Row& row : rows) {
         nlohmann::json entry{{"model", row.model},         {"algorithm", row.algorithm}, {"primitives", row.primitives},
                              {"time_ms", row.median_ms},   {"candidates", row.candidates}, {"cost", row.cost},
-                             {"height", row.height},       {"relative_to_two_level", row.relative},
+                             {"height", row.height},
+                             {"relative_to_two_level", row.relative ? nlohmann::json(*row.relative) : nlohmann::json(nullptr)},
                              {"budget_hit", row.budget_hit}};
         // A fraction (0.05 = 5 % above the optimum); null where the optimum is unknown.
         entry["gap_to_optimum"] = row.gap ? nlohmann::json(*row.gap) : nlohmann::json(nullptr);
@@ -217,16 +223,26 @@ int run_compare(const CompareArguments& args) {
         std::min({args.optimum_max_primitives, OptimalOptions{}.max_primitives, optimal_hard_limit});
     std::vector<Row> rows;
     for (const std::string& input : args.inputs) {
-        Result<Model> model = load_model(input);
-        if (!model) return report_error(model.error());
-        report_warnings(model->warnings);
-        const std::size_t count = model->primitives.size();
         // The file's stem, unless another input has the same one (d1/m.xml, d2/m.xml): then the path as given.
         const std::string stem = std::filesystem::path(input).stem().string();
         const bool shared_stem = std::count_if(args.inputs.begin(), args.inputs.end(), [&](const std::string& other) {
                                      return std::filesystem::path(other).stem().string() == stem;
                                  }) > 1;
         const std::string name = shared_stem ? input : stem;
+        Result<Model> model = load_model(input);
+        if (!model) {
+            // One unreadable model is a failed row, not the end of the table: the others are still measured, and
+            // compare exits 1 (it printed nothing for the models before it).
+            report_error(model.error());
+            Row row;
+            row.model = name;
+            row.algorithm = "-";
+            row.error = model.error().to_string();
+            rows.push_back(std::move(row));
+            continue;
+        }
+        report_warnings(model->warnings);
+        const std::size_t count = model->primitives.size();
         fmt::print(stderr, "hbvh compare: {} ({})\n", name, counted(count, "primitive", "primitives"));
         const double baseline = measure(model->primitives, Algorithm::two_level, settings, 1).cost;
         const std::size_t first = rows.size();
@@ -241,7 +257,7 @@ int run_compare(const CompareArguments& args) {
                 row = measure(model->primitives, algorithm, settings, args.repeats);
             }
             row.model = name;
-            row.relative = baseline > 0.0 ? row.cost / baseline : 1.0;
+            if (baseline > 0.0) row.relative = row.cost / baseline;
             rows.push_back(std::move(row));
         }
         // The optimum: the `optimal` row's when the list has one, else one extra build.
@@ -294,7 +310,8 @@ void add_compare_command(CLI::App& app, Command& command) {
         "--optimum-max-primitives primitives. Rows whose solver stopped at its budget are marked.\n"
         "--time-limit bounds every build, optimal's too (bnb-tightest and bnb-enlarge spread it over their solver\n"
         "calls); an optimal build it stops proves no optimum, so that model's gaps are then unknown.\n"
-        "A row whose build fails prints its error, and compare then exits 1.\n"
+        "A row whose build fails, or a model that cannot be read (algorithm '-'), prints its error; the other\n"
+        "rows are still measured, and compare then exits 1. cost / two-level is '-' (JSON null) where both are 0.\n"
         "Example: hbvh compare data/models/*.xml --markdown");
     sub->callback([&command, args] { command = [args] { return run_compare(*args); }; });
 }
