@@ -150,7 +150,10 @@ Result<ModelFile> read_model_file(const std::string& path, std::string_view form
         // An .xml whose root is <mujoco> (MJCF) or <robot> (URDF) goes to the importer below, unless the format
         // says otherwise; the root's name, not a search of the text, which a comment could fool either way.
         const std::string_view root = root_element_name(text.value());
-        const bool survey = !automatic || (by_bytes ? root == "hierarchy" : root != "mujoco" && root != "robot");
+        // An empty file of any name goes to the XML reader too, whose "file is empty" says what is wrong.
+        const bool blank = text->find_first_not_of(" \t\r\n") == std::string::npos;
+        const bool survey =
+            !automatic || blank || (by_bytes ? root == "hierarchy" : root != "mujoco" && root != "robot");
         // The XML reader takes the text over: a 230 MB file is parsed where it was read, not copied.
         if (survey) return from_xml(detail::read_xml_taking(std::move(text).value(), path));
         if (by_bytes)

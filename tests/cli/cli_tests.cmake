@@ -307,3 +307,5 @@ hbvh_cli_test(option_before_command 2 "hbvh: unknown option '--bogus': options f
 # compare --bnb-nodes -1 wrapped to 2^64 - 1, an unlimited search.
 hbvh_cli_test(compare_negative_bnb_nodes 2 "--bnb-nodes: '-1' is not a whole number"
               compare ${PROJECT_SOURCE_DIR}/data/models/chair.xml --bnb-nodes -1)
+# An empty input whose name tells no format said "unknown file type ''" (2026-12-08).
+hbvh_cli_test(empty_without_extension 1 "/dev/null:1: file is empty" build /dev/null -o -)
