@@ -2,6 +2,7 @@
 // `hbvh collide`: do two posed objects touch, and which primitive pairs overlap.
 #include <fmt/core.h>
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include <charconv>
 #include <iterator>
@@ -25,7 +26,13 @@ struct CollideArguments {
     BuilderFlags builder;
     bool first = false;
     bool json = false;
+    bool names = false;  ///< --names: each pair's primitive names too.
 };
+
+/// A name as a JSON string (quoted, escaped; bytes that are no UTF-8 as U+FFFD, as the writers do).
+std::string json_quoted(const std::string& name) {
+    return nlohmann::json(name).dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
 
 /// "tx ty tz [qw qx qy qz]": a translation and an optional rotation quaternion (normalised).
 Result<RigidTransform> parse_pose(const std::string& text, const char* flag) {
@@ -97,10 +104,28 @@ int run_collide(const CollideArguments& args) {
                            result.pairs[k].second);
             if (text.size() >= (std::size_t{1} << 20)) fmt::print("{}", text), text.clear();
         }
-        fmt::print("{}],\"bv_tests\":{},\"primitive_tests\":{}}}\n", text, result.bv_tests, result.primitive_tests);
+        text += ']';
+        if (args.names) {
+            // Names are what stays put across formats: survey XML lists primitives in tree order, so the same
+            // model read from its source and from a built XML numbers them differently.
+            text += ",\"names\":[";
+            for (std::size_t k = 0; k < result.pairs.size(); ++k) {
+                const auto [i, j] = result.pairs[k];
+                fmt::format_to(std::back_inserter(text), "{}[{},{}]", k == 0 ? "" : ",",
+                               json_quoted(bvh_a->primitives[i].name), json_quoted(bvh_b->primitives[j].name));
+                if (text.size() >= (std::size_t{1} << 20)) fmt::print("{}", text), text.clear();
+            }
+            text += ']';
+        }
+        fmt::print("{},\"bv_tests\":{},\"primitive_tests\":{}}}\n", text, result.bv_tests, result.primitive_tests);
     } else {
         fmt::print("{}\n", result.intersecting ? "intersecting" : "separate");
-        for (const auto& [i, j] : result.pairs) fmt::print("  {} {}\n", i, j);
+        for (const auto& [i, j] : result.pairs) {
+            if (args.names)
+                fmt::print("  {} {} {} {}\n", i, j, json_quoted(bvh_a->primitives[i].name), json_quoted(bvh_b->primitives[j].name));
+            else
+                fmt::print("  {} {}\n", i, j);
+        }
         fmt::print("bv tests {}, primitive tests {}, nodes visited {}\n", result.bv_tests, result.primitive_tests,
                    result.nodes_visited);
     }
@@ -120,8 +145,10 @@ void add_collide_command(CLI::App& app, Command& command) {
     args->builder.add_to(*sub);
     args->builder.add_refit_to(*sub);
     sub->add_flag("--first", args->first, "Stop at the first overlapping pair");
-    sub->add_flag("--json", args->json, "Print {intersecting, pairs, bv_tests, primitive_tests}");
-    sub->footer("Pairs are (primitive of a, primitive of b) in input order.\n"
+    sub->add_flag("--json", args->json, "Print {intersecting, pairs, bv_tests, primitive_tests} (and names)");
+    sub->add_flag("--names", args->names, "Also print each pair's primitive names (JSON strings; \"\" for none)");
+    sub->footer("Pairs are (primitive of a, primitive of b) in each file's order; survey XML lists primitives in\n"
+                "tree order, so a model and a hierarchy built from it number them differently: --names says which.\n"
                 "Example: hbvh collide data/models/chair.xml data/models/chair.xml --pose-b \"0.3 0 0\" --json");
     sub->callback([&command, args] { command = [args] { return run_collide(*args); }; });
 }
