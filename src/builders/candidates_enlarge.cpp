@@ -47,13 +47,34 @@ std::optional<std::uint32_t> first_colliding_step(const BoundingVolume& bv, cons
     return hi;
 }
 
-/// Appends every subset of `colliders` of size 1..max_extra, each joined with `node`.
-void append_subsets(std::uint32_t node, const std::vector<std::uint32_t>& colliders, std::uint32_t max_extra,
-                    std::vector<std::vector<std::uint32_t>>& out) {
+/// The number of subsets of `k` colliders of size 1..max_extra, saturating at `cap` + 1.
+std::uint64_t subset_count(std::uint64_t k, std::uint64_t max_extra, std::uint64_t cap) {
+    std::uint64_t total = 0;
+    std::uint64_t binomial = 1;  // C(k, s), built up s by s
+    for (std::uint64_t s = 1; s <= max_extra && s <= k; ++s) {
+        // C(k, s) = C(k, s - 1) (k - s + 1) / s, in long double to pass the cap without overflow.
+        const long double next = static_cast<long double>(binomial) * static_cast<long double>(k - s + 1) / s;
+        if (next > static_cast<long double>(cap)) return cap + 1;
+        binomial = static_cast<std::uint64_t>(next + 0.5L);
+        total += binomial;
+        if (total > cap) return cap + 1;
+    }
+    return total;
+}
+
+/// Appends every subset of `colliders` of size 1..max_extra, each joined with `node`; the level's deadline is
+/// checked every few thousand subsets (one node's could take seconds).
+void append_subsets(const Level& level, std::uint32_t node, const std::vector<std::uint32_t>& colliders,
+                    std::uint32_t max_extra, std::vector<std::vector<std::uint32_t>>& out) {
     std::vector<std::uint32_t> chosen;
+    std::uint32_t since_check = 0;
     // Depth-first over colliders in canonical order; each prefix choice is emitted once.
     auto recurse = [&](auto&& self, std::size_t from) -> void {
         for (std::size_t i = from; i < colliders.size(); ++i) {
+            if (++since_check == 4096) {
+                since_check = 0;
+                level.check_deadline();
+            }
             chosen.push_back(colliders[i]);
             std::vector<std::uint32_t> set = chosen;
             set.push_back(node);
@@ -121,8 +142,13 @@ std::vector<std::vector<std::uint32_t>> enlarge_candidates(const Level& level, c
             if (options.max_colliders > 0 && colliders.size() == options.max_colliders) break;
             colliders.push_back(j);
         }
+        // The first colliders (in the order reached) whose subsets stay within the cap.
+        if (options.max_subsets_per_node > 0)
+            while (colliders.size() > 1 &&
+                   subset_count(colliders.size(), max_size - 1, options.max_subsets_per_node) > options.max_subsets_per_node)
+                colliders.pop_back();
         std::sort(colliders.begin(), colliders.end());
-        append_subsets(i, colliders, max_size - 1, sets);
+        append_subsets(level, i, colliders, max_size - 1, sets);
     }
     return sets;
 }

@@ -18,7 +18,8 @@ Result<Bvh> build_two_level(std::span<const Primitive> primitives, const BuildCo
 BoundingVolume detail::root_volume(std::span<const Primitive> primitives, const VolumePolicy& policy, RootFit fit) {
     FitInput input;
     for (const Primitive& primitive : primitives) input.add(primitive.volume);
-    if (fit == RootFit::quick) return fit_fast(input.spheres, {}, policy, FastFitMode::quick_sphere);
+    if (fit == RootFit::quick && primitives.size() > quick_root_min_primitives)
+        return fit_fast(input.spheres, {}, policy, FastFitMode::quick_sphere);
     return fit_best(input.spheres, policy, input.hint_axes);
 }
 

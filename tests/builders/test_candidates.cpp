@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <map>
 #include <numbers>
 #include <set>
 #include <vector>
@@ -92,6 +93,32 @@ TEST(EnlargeCandidates, APassedDeadlineStopsTheGrowthTests) {
     EXPECT_THROW((void)enlarge_candidates(level), LevelDeadlinePassed);
     level.stop_fitting_after(BuildContext::Clock::time_point::max());
     EXPECT_EQ(normalised(enlarge_candidates(level)), (std::set<std::vector<std::uint32_t>>{{0, 1}, {1, 2}}));
+}
+
+TEST(EnlargeCandidates, ANodeMeetingEveryOtherOffersNoMoreSubsetsThanTheCap) {
+    // 16 balls around one point: every node meets the 15 others at step 0 and offers every subset of up to
+    // floor(lg 16) - 1 = 3 of them, 15 + 105 + 455 = 575. With a cap of 100 a node keeps its first 8 colliders
+    // (8 + 28 + 56 = 92; 9 would make 129). 100 such spheres made 7.5e7 subsets a node, 6 GB, before the cap.
+    std::vector<Primitive> primitives;
+    for (int i = 0; i < 16; ++i) primitives.push_back(ball(0.01 * i, 1));
+    const Level level = make_level(primitives, VolumePolicy::all());
+    const auto per_node = [&](const EnlargeOptions& options) {
+        std::map<std::uint32_t, std::size_t> count;
+        for (const std::vector<std::uint32_t>& set : enlarge_candidates(level, options)) ++count[set.back()];
+        return count;
+    };
+    EnlargeOptions uncapped;
+    uncapped.max_subsets_per_node = 0;
+    EnlargeOptions capped;
+    capped.max_subsets_per_node = 100;
+    const auto all = per_node(uncapped);
+    const auto kept = per_node(capped);
+    ASSERT_EQ(all.size(), 16u);
+    ASSERT_EQ(kept.size(), 16u);
+    for (std::uint32_t node = 0; node < 16; ++node) {
+        EXPECT_EQ(all.at(node), 575u) << node;
+        EXPECT_EQ(kept.at(node), 92u) << node;
+    }
 }
 
 TEST(EnlargeCandidates, AllSubsetsOfCollidersUpToLgN) {
