@@ -107,8 +107,9 @@ TEST(Registry, EveryBuilderHonoursAPassedDeadlineWithAValidTree) {
         // Stopped at once, a builder has at best the two-level tree: its root must be fitted as well as that tree's
         // (a root fitted by the quick fitter cost up to 60 % more; auto's first member always runs, and fast refits
         // its root, so both may do better).
-        if (row.algorithm() != Algorithm::automatic && row.algorithm() != Algorithm::fast)
+        if (row.algorithm() != Algorithm::automatic && row.algorithm() != Algorithm::fast) {
             EXPECT_LE(cost(*built), cost(two_level) * (1.0 + 1e-12)) << row.name;
+        }
     }
 }
 
