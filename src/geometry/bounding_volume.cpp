@@ -67,21 +67,7 @@ bool contains(const BoundingVolume& bv, const Sphere& s, double tolerance) {
 }
 
 double protrusion(const BoundingVolume& bv, const Sphere& s) {
-    return std::visit(Overloaded{
-                          [&](const Aabb& box) {
-                              const Vec3 below = box.min - s.center, above = s.center - box.max;
-                              return below.cwiseMax(above).maxCoeff() + s.radius;
-                          },
-                          [&](const Obb& box) {
-                              const Vec3 local = box.rotation.transpose() * (s.center - box.center);
-                              return (local.cwiseAbs() - box.half_extents).maxCoeff() + s.radius;
-                          },
-                          [&](const Sphere& sphere) { return (s.center - sphere.center).norm() + s.radius - sphere.radius; },
-                          [&](const Capsule& capsule) {
-                              return (s.center - capsule.closest_axis_point(s.center)).norm() + s.radius - capsule.radius;
-                          },
-                      },
-                      bv);
+    return std::visit([&](const auto& v) { return protrusion(v, s); }, bv);
 }
 
 Aabb world_aabb(const BoundingVolume& bv) {

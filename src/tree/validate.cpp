@@ -159,24 +159,10 @@ std::optional<ContainmentViolation> worst_reach(std::uint32_t node, const Boundi
     std::optional<std::uint32_t> primitive;
     std::visit(
         [&](const auto& v) {
-            // protrusion()'s arithmetic, kind by kind, so that the verdicts and the reported reach are its own.
-            using Kind = std::decay_t<decltype(v)>;
-            for (std::size_t k = 0; k < spheres.size(); ++k) {
-                const Sphere& s = spheres[k];
-                double reach;
-                if constexpr (std::is_same_v<Kind, Aabb>) {
-                    reach = (v.min - s.center).cwiseMax(s.center - v.max).maxCoeff() + s.radius;
-                } else if constexpr (std::is_same_v<Kind, Obb>) {
-                    const Vec3 local = v.rotation.transpose() * (s.center - v.center);
-                    reach = (local.cwiseAbs() - v.half_extents).maxCoeff() + s.radius;
-                } else if constexpr (std::is_same_v<Kind, Sphere>) {
-                    reach = (s.center - v.center).norm() + s.radius - v.radius;
-                } else {
-                    reach = (s.center - v.closest_axis_point(s.center)).norm() + s.radius - v.radius;
-                }
-                if (reach > worst || (primitive && reach == worst && primitive_of[k] < *primitive))
+            for (std::size_t k = 0; k < spheres.size(); ++k)
+                if (const double reach = protrusion(v, spheres[k]);
+                    reach > worst || (primitive && reach == worst && primitive_of[k] < *primitive))
                     worst = reach, primitive = primitive_of[k];
-            }
         },
         volume);
     if (!primitive) return std::nullopt;

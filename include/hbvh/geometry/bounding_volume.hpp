@@ -61,6 +61,21 @@ inline constexpr std::array<BvType, bv_type_count> all_bv_types{BvType::aabb, Bv
 /// volume's faces (boxes) or outside its round surface (spheres, capsules); <= 0 when `s` is inside.
 /// contains(bv, s, tolerance) is protrusion(bv, s) <= tolerance, up to rounding.
 [[nodiscard]] double protrusion(const BoundingVolume& bv, const Sphere& s);
+/// protrusion() for one kind, for loops that dispatch on the kind once and not per sphere (the containment check).
+[[nodiscard]] inline double protrusion(const Aabb& box, const Sphere& s) {
+    const Vec3 below = box.min - s.center, above = s.center - box.max;
+    return below.cwiseMax(above).maxCoeff() + s.radius;
+}
+[[nodiscard]] inline double protrusion(const Obb& box, const Sphere& s) {
+    const Vec3 local = box.rotation.transpose() * (s.center - box.center);
+    return (local.cwiseAbs() - box.half_extents).maxCoeff() + s.radius;
+}
+[[nodiscard]] inline double protrusion(const Sphere& sphere, const Sphere& s) {
+    return (s.center - sphere.center).norm() + s.radius - sphere.radius;
+}
+[[nodiscard]] inline double protrusion(const Capsule& capsule, const Sphere& s) {
+    return (s.center - capsule.closest_axis_point(s.center)).norm() + s.radius - capsule.radius;
+}
 /// Smallest world axis-aligned box around the BV (exact for every kind).
 [[nodiscard]] Aabb world_aabb(const BoundingVolume& bv);
 /// A length scale of the BV (half the diagonal of its world AABB), used to make tolerances relative.
